@@ -1,0 +1,11 @@
+// The scene and film bindings, shared by every kernel.
+#include "common.wgsl"
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> nodes: array<BvhNode>;
+@group(0) @binding(2) var<storage, read> triangles: array<Triangle>;
+@group(0) @binding(3) var<storage, read> normals: array<Normals>;
+@group(0) @binding(4) var<storage, read> materials: array<Material>;
+@group(0) @binding(5) var<storage, read> lights: array<LightEntry>;
+// Two rows per pixel: (Σ L, sample count) and (Σ L², dropped non-finite samples).
+@group(0) @binding(6) var<storage, read_write> film: array<vec4<f32>>;

@@ -1,0 +1,120 @@
+// Ray–scene intersection: Möller–Trumbore triangles in a BVH2 walked with a small stack,
+// nearer child first. Twin: src/cpu/bvh.rs.
+#include "bindings.wgsl"
+
+const NO_HIT: u32 = 0xffffffffu;
+const STACK_SIZE: u32 = 64u;
+
+struct Hit {
+    t: f32,
+    tri: u32,
+    // Barycentrics of vertices 1 and 2.
+    u: f32,
+    v: f32,
+}
+
+// Distance along the ray (t, u, v), or t = INF on a miss.
+fn intersect_triangle(ray: Ray, tri: Triangle) -> vec3<f32> {
+    let pvec = cross(ray.dir, tri.e2);
+    let det = dot(tri.e1, pvec);
+    if (det == 0.0) {
+        return vec3<f32>(INF, 0.0, 0.0);
+    }
+    let inv_det = 1.0 / det;
+    let tvec = ray.origin - tri.p0;
+    let u = dot(tvec, pvec) * inv_det;
+    if (u < 0.0 || u > 1.0) {
+        return vec3<f32>(INF, 0.0, 0.0);
+    }
+    let qvec = cross(tvec, tri.e1);
+    let v = dot(ray.dir, qvec) * inv_det;
+    if (v < 0.0 || u + v > 1.0) {
+        return vec3<f32>(INF, 0.0, 0.0);
+    }
+    let t = dot(tri.e2, qvec) * inv_det;
+    return vec3<f32>(select(INF, t, t > 0.0), u, v);
+}
+
+// Entry distance of the ray into a node's box within [0, t_max], or INF.
+fn intersect_node(node: BvhNode, origin: vec3<f32>, inv_dir: vec3<f32>, t_max: f32) -> f32 {
+    let t0 = (node.min - origin) * inv_dir;
+    let t1 = (node.max - origin) * inv_dir;
+    let near = min(t0, t1);
+    let far = max(t0, t1);
+    let t_enter = max(max(near.x, near.y), max(near.z, 0.0));
+    let t_exit = min(min(far.x, far.y), min(far.z, t_max));
+    return select(INF, t_enter, t_enter <= t_exit);
+}
+
+// Closest hit with t < t_max; `any_hit` stops at the first one (shadow rays).
+fn trace(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
+    var hit = Hit(t_max, NO_HIT, 0.0, 0.0);
+    let inv_dir = 1.0 / ray.dir;
+    var stack: array<u32, STACK_SIZE>;
+    var sp = 0u;
+    var index = 0u;
+    if (intersect_node(nodes[0], ray.origin, inv_dir, hit.t) == INF) {
+        return hit;
+    }
+    loop {
+        let node = nodes[index];
+        if (node.count > 0u) {
+            for (var i = node.index; i < node.index + node.count; i++) {
+                let r = intersect_triangle(ray, triangles[i]);
+                if (r.x < hit.t) {
+                    hit = Hit(r.x, i, r.y, r.z);
+                    if (any_hit) {
+                        return hit;
+                    }
+                }
+            }
+        } else {
+            let left = node.index;
+            let right = node.index + 1u;
+            let t_left = intersect_node(nodes[left], ray.origin, inv_dir, hit.t);
+            let t_right = intersect_node(nodes[right], ray.origin, inv_dir, hit.t);
+            if (t_left != INF && t_right != INF) {
+                let near_is_left = t_left <= t_right;
+                if (sp < STACK_SIZE) {
+                    stack[sp] = select(left, right, near_is_left);
+                    sp += 1u;
+                }
+                index = select(right, left, near_is_left);
+                continue;
+            }
+            if (t_left != INF) {
+                index = left;
+                continue;
+            }
+            if (t_right != INF) {
+                index = right;
+                continue;
+            }
+        }
+        if (sp == 0u) {
+            break;
+        }
+        sp -= 1u;
+        index = stack[sp];
+    }
+    return hit;
+}
+
+fn intersect_closest(ray: Ray) -> Hit {
+    return trace(ray, INF, false);
+}
+
+// True when something blocks the segment origin → origin + dir·t_max.
+fn occluded(ray: Ray, t_max: f32) -> bool {
+    return trace(ray, t_max, true).tri != NO_HIT;
+}
+
+// Moves a surface point off its surface along the normal by a few ulps, so a spawned ray
+// cannot hit the surface it starts on at any scene scale (Wächter & Binder, Ray Tracing
+// Gems ch. 6).
+fn offset_ray(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let of_i = vec3<i32>(256.0 * n);
+    let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
+    let near_origin = abs(p) < vec3<f32>(1.0 / 32.0);
+    return select(p_i, p + (1.0 / 65536.0) * n, near_origin);
+}

@@ -1,0 +1,89 @@
+// Shared constants and the packed-scene layouts (twins of src/packed.rs and src/gpu/params.rs).
+
+const PI: f32 = 3.14159265358979;
+const INV_PI: f32 = 0.31830988618379;
+const INF: f32 = 3.4e38;
+
+const STRATEGY_BSDF: u32 = 0u;
+const STRATEGY_LIGHT: u32 = 1u;
+const STRATEGY_MIS_BALANCE: u32 = 2u;
+const STRATEGY_MIS_POWER: u32 = 3u;
+
+struct BvhNode {
+    min: vec3<f32>,
+    index: u32,
+    max: vec3<f32>,
+    count: u32,
+}
+
+struct Triangle {
+    p0: vec3<f32>,
+    material: u32,
+    e1: vec3<f32>,
+    light_pdf_area: f32,
+    e2: vec3<f32>,
+    flags: u32,
+}
+
+const TRI_HAS_NORMALS: u32 = 1u;
+
+struct Normals {
+    n: vec3<u32>,
+    pad: u32,
+}
+
+struct Material {
+    base_color: vec3<f32>,
+    metallic: f32,
+    emission: vec3<f32>,
+    roughness: f32,
+    specular: vec3<f32>,
+    ior: f32,
+}
+
+struct LightEntry {
+    triangle: u32,
+    alias_slot: u32,
+    prob: f32,
+    pmf: f32,
+}
+
+// Per-dispatch parameters. `cam_right` and `cam_up` are pre-scaled by the image-plane half
+// extents so a camera ray is forward + x·right + y·up.
+struct Params {
+    cam_position: vec3<f32>,
+    film_width: u32,
+    cam_right: vec3<f32>,
+    film_height: u32,
+    cam_up: vec3<f32>,
+    sample_index: u32,
+    cam_forward: vec3<f32>,
+    seed: u32,
+    environment: vec3<f32>,
+    max_depth: u32,
+    strategy: u32,
+    light_count: u32,
+    rr_depth: u32,
+    image_width: u32,
+    image_height: u32,
+    tile_x: u32,
+    tile_y: u32,
+    pad: u32,
+}
+
+struct Ray {
+    origin: vec3<f32>,
+    dir: vec3<f32>,
+}
+
+fn max_component(v: vec3<f32>) -> f32 {
+    return max(v.x, max(v.y, v.z));
+}
+
+fn is_finite_f32(x: f32) -> bool {
+    return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
+}
+
+fn is_finite_vec3(v: vec3<f32>) -> bool {
+    return is_finite_f32(v.x) && is_finite_f32(v.y) && is_finite_f32(v.z);
+}

@@ -1,0 +1,143 @@
+// The path tracer: one sample per pixel per dispatch, next-event estimation at every vertex
+// combined with BSDF sampling by MIS (or either strategy alone). Twin: src/cpu/integrator.rs.
+#include "bindings.wgsl"
+#include "rng.wgsl"
+#include "frame.wgsl"
+#include "bvh.wgsl"
+#include "camera.wgsl"
+#include "bsdf.wgsl"
+#include "lights.wgsl"
+#include "mis.wgsl"
+
+fn shading_normal(tri: Triangle, index: u32, u: f32, v: f32, ng: vec3<f32>) -> vec3<f32> {
+    if ((tri.flags & TRI_HAS_NORMALS) == 0u) {
+        return ng;
+    }
+    let packed = normals[index].n;
+    let n = (1.0 - u - v) * oct_decode(packed.x) + u * oct_decode(packed.y) + v * oct_decode(packed.z);
+    let len2 = dot(n, n);
+    return select(ng, n * inverseSqrt(len2), len2 > 0.0);
+}
+
+fn oct_decode(bits: u32) -> vec3<f32> {
+    let e = unpack2x16snorm(bits);
+    let z = 1.0 - abs(e.x) - abs(e.y);
+    let t = max(-z, 0.0);
+    let x = e.x + select(t, -t, e.x >= 0.0);
+    let y = e.y + select(t, -t, e.y >= 0.0);
+    return normalize(vec3<f32>(x, y, z));
+}
+
+// Radiance arriving along a camera ray. Path depth counts segments (Mitsuba's max_depth).
+fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
+    let strategy = params.strategy;
+    var radiance = vec3<f32>(0.0);
+    var beta = vec3<f32>(1.0);
+    var ray = camera_ray;
+    var depth = 0u;
+    var prev_pdf = 0.0;
+    var prev_delta = true;
+    loop {
+        let hit = intersect_closest(ray);
+        depth += 1u;
+        if (hit.tri == NO_HIT) {
+            radiance += beta * params.environment;
+            break;
+        }
+        let tri = triangles[hit.tri];
+        let m = materials[tri.material];
+        let point = tri.p0 + hit.u * tri.e1 + hit.v * tri.e2;
+        let ng_raw = normalize(cross(tri.e1, tri.e2));
+        let cos_hit = dot(ray.dir, ng_raw);
+
+        // Emission found by the BSDF sample of the previous vertex (or the camera ray).
+        if (cos_hit < 0.0 && max_component(m.emission) > 0.0) {
+            var w = 1.0;
+            if (depth > 1u && !prev_delta) {
+                if (strategy == STRATEGY_LIGHT) {
+                    w = 0.0;
+                } else if (strategy != STRATEGY_BSDF) {
+                    w = mis_weight(strategy, prev_pdf, light_pdf(tri, hit.t * hit.t, cos_hit));
+                }
+            }
+            radiance += beta * m.emission * w;
+        }
+        if (params.max_depth != 0u && depth >= params.max_depth) {
+            break;
+        }
+
+        // Surfaces are two-sided: face both normals towards the incoming ray.
+        let ng = select(ng_raw, -ng_raw, cos_hit > 0.0);
+        var ns = shading_normal(tri, hit.tri, hit.u, hit.v, ng_raw);
+        ns = select(ns, -ns, dot(ns, ray.dir) > 0.0);
+        let frame = frame_from_normal(ns);
+        let wo = to_local(frame, -ray.dir);
+        let origin = offset_ray(point, ng);
+
+        // Next-event estimation: one light sample.
+        if (strategy != STRATEGY_BSDF && params.light_count > 0u) {
+            let u_light = vec3<f32>(rng_next(rng), rng_next2(rng));
+            let ls = sample_light(point, u_light);
+            if (ls.pdf > 0.0) {
+                let target_point = offset_ray(ls.point, ls.normal);
+                let wi = normalize(ls.point - point);
+                let wi_local = to_local(frame, wi);
+                let f = bsdf_eval(m, wo, wi_local);
+                if (dot(wi, ng) > 0.0 && max_component(f) > 0.0 &&
+                    !occluded(Ray(origin, target_point - origin), 1.0)) {
+                    var w = 1.0;
+                    if (strategy != STRATEGY_LIGHT) {
+                        w = mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, wi_local));
+                    }
+                    radiance += beta * f * abs(wi_local.z) * ls.radiance * (w / ls.pdf);
+                }
+            }
+        }
+
+        // BSDF sample: continues the path (and finds emitters for the MIS estimator).
+        let u_bsdf = vec3<f32>(rng_next(rng), rng_next2(rng));
+        let bs = bsdf_sample(m, wo, u_bsdf);
+        if (bs.pdf <= 0.0) {
+            break;
+        }
+        let wi = from_local(frame, bs.wi);
+        // A reflection that the shading normal allows but the geometry does not would leak light.
+        if (dot(wi, ng) <= 0.0) {
+            break;
+        }
+        beta *= bs.weight;
+        if (max_component(beta) <= 0.0) {
+            break;
+        }
+        prev_pdf = bs.pdf;
+        prev_delta = bs.delta;
+        ray = Ray(origin, wi);
+
+        if (depth >= params.rr_depth) {
+            let q = min(max_component(beta), 0.95);
+            if (rng_next(rng) >= q) {
+                break;
+            }
+            beta /= q;
+        }
+    }
+    return radiance;
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn render_sample(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.film_width || gid.y >= params.film_height) {
+        return;
+    }
+    let pixel = vec2<u32>(gid.x + params.tile_x, gid.y + params.tile_y);
+    var rng = rng_init(pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
+    let ray = generate_ray(pixel, rng_next2(&rng));
+    let l = li(ray, &rng);
+    let i = 2u * (gid.y * params.film_width + gid.x);
+    if (is_finite_vec3(l)) {
+        film[i] += vec4<f32>(l, 1.0);
+        film[i + 1u] += vec4<f32>(l * l, 0.0);
+    } else {
+        film[i + 1u].w += 1.0;
+    }
+}

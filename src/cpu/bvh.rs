@@ -1,0 +1,123 @@
+//! Twin of `shaders/bvh.wgsl`: the same traversal over the same nodes.
+
+use crate::packed::{BvhNode, PackedTriangle};
+use glam::{IVec3, Vec3};
+
+pub const NO_HIT: u32 = u32::MAX;
+const STACK_SIZE: usize = 64;
+pub const INF: f32 = 3.4e38;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    pub origin: Vec3,
+    pub dir: Vec3,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub tri: u32,
+    pub u: f32,
+    pub v: f32,
+}
+
+pub fn intersect_triangle(ray: &Ray, tri: &PackedTriangle) -> Vec3 {
+    let (p0, e1, e2) = (Vec3::from(tri.p0), Vec3::from(tri.e1), Vec3::from(tri.e2));
+    let pvec = ray.dir.cross(e2);
+    let det = e1.dot(pvec);
+    if det == 0.0 {
+        return Vec3::new(INF, 0.0, 0.0);
+    }
+    let inv_det = 1.0 / det;
+    let tvec = ray.origin - p0;
+    let u = tvec.dot(pvec) * inv_det;
+    if !(0.0..=1.0).contains(&u) {
+        return Vec3::new(INF, 0.0, 0.0);
+    }
+    let qvec = tvec.cross(e1);
+    let v = ray.dir.dot(qvec) * inv_det;
+    if v < 0.0 || u + v > 1.0 {
+        return Vec3::new(INF, 0.0, 0.0);
+    }
+    let t = e2.dot(qvec) * inv_det;
+    Vec3::new(if t > 0.0 { t } else { INF }, u, v)
+}
+
+pub fn intersect_node(node: &BvhNode, origin: Vec3, inv_dir: Vec3, t_max: f32) -> f32 {
+    let t0 = (Vec3::from(node.min) - origin) * inv_dir;
+    let t1 = (Vec3::from(node.max) - origin) * inv_dir;
+    let near = t0.min(t1);
+    let far = t0.max(t1);
+    let t_enter = near.x.max(near.y).max(near.z.max(0.0));
+    let t_exit = far.x.min(far.y).min(far.z.min(t_max));
+    if t_enter <= t_exit { t_enter } else { INF }
+}
+
+pub fn trace(nodes: &[BvhNode], triangles: &[PackedTriangle], ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
+    let mut hit = Hit { t: t_max, tri: NO_HIT, u: 0.0, v: 0.0 };
+    let inv_dir = Vec3::ONE / ray.dir;
+    let mut stack = [0u32; STACK_SIZE];
+    let mut sp = 0usize;
+    let mut index = 0usize;
+    if intersect_node(&nodes[0], ray.origin, inv_dir, hit.t) == INF {
+        return hit;
+    }
+    loop {
+        let node = &nodes[index];
+        if node.count > 0 {
+            for i in node.index..node.index + node.count {
+                let r = intersect_triangle(ray, &triangles[i as usize]);
+                if r.x < hit.t {
+                    hit = Hit { t: r.x, tri: i, u: r.y, v: r.z };
+                    if any_hit {
+                        return hit;
+                    }
+                }
+            }
+        } else {
+            let (left, right) = (node.index as usize, node.index as usize + 1);
+            let t_left = intersect_node(&nodes[left], ray.origin, inv_dir, hit.t);
+            let t_right = intersect_node(&nodes[right], ray.origin, inv_dir, hit.t);
+            if t_left != INF && t_right != INF {
+                let near_is_left = t_left <= t_right;
+                if sp < STACK_SIZE {
+                    stack[sp] = if near_is_left { right } else { left } as u32;
+                    sp += 1;
+                }
+                index = if near_is_left { left } else { right };
+                continue;
+            }
+            if t_left != INF {
+                index = left;
+                continue;
+            }
+            if t_right != INF {
+                index = right;
+                continue;
+            }
+        }
+        if sp == 0 {
+            break;
+        }
+        sp -= 1;
+        index = stack[sp] as usize;
+    }
+    hit
+}
+
+pub fn intersect_closest(nodes: &[BvhNode], triangles: &[PackedTriangle], ray: &Ray) -> Hit {
+    trace(nodes, triangles, ray, INF, false)
+}
+
+pub fn occluded(nodes: &[BvhNode], triangles: &[PackedTriangle], ray: &Ray, t_max: f32) -> bool {
+    trace(nodes, triangles, ray, t_max, true).tri != NO_HIT
+}
+
+pub fn offset_ray(p: Vec3, n: Vec3) -> Vec3 {
+    let of_i = (256.0 * n).as_ivec3();
+    let bump = |pc: f32, o: i32| f32::from_bits((pc.to_bits() as i32).wrapping_add(if pc < 0.0 { -o } else { o }) as u32);
+    let p_i = Vec3::new(bump(p.x, of_i.x), bump(p.y, of_i.y), bump(p.z, of_i.z));
+    let pick = |pc: f32, pi: f32, nc: f32| if pc.abs() < 1.0 / 32.0 { pc + (1.0 / 65536.0) * nc } else { pi };
+    let _: IVec3 = of_i;
+    Vec3::new(pick(p.x, p_i.x, n.x), pick(p.y, p_i.y, n.y), pick(p.z, p_i.z, n.z))
+}

@@ -1,0 +1,131 @@
+//! Twin of `shaders/integrator.wgsl`: the path tracer, sample for sample.
+
+use super::bsdf::{bsdf_eval, bsdf_pdf, bsdf_sample};
+use super::bvh::{NO_HIT, Ray, intersect_closest, occluded, offset_ray};
+use super::camera::generate_ray;
+use super::frame::{frame_from_normal, from_local, to_local};
+use super::lights::{light_pdf, sample_light};
+use super::mis::mis_weight;
+use super::rng::{rng_init, rng_next, rng_next2};
+use crate::Strategy;
+use crate::packed::{PackedScene, PackedTriangle, TRI_HAS_NORMALS, oct_decode};
+use crate::params::Params;
+use glam::{UVec2, Vec3};
+
+fn shading_normal(scene: &PackedScene, tri: &PackedTriangle, index: u32, u: f32, v: f32, ng: Vec3) -> Vec3 {
+    if tri.flags & TRI_HAS_NORMALS == 0 {
+        return ng;
+    }
+    let packed = scene.normals[index as usize].n;
+    let n = (1.0 - u - v) * oct_decode(packed[0]) + u * oct_decode(packed[1]) + v * oct_decode(packed[2]);
+    let len2 = n.dot(n);
+    if len2 > 0.0 { n / len2.sqrt() } else { ng }
+}
+
+pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) -> Vec3 {
+    let strategy = Strategy::from_u32(params.strategy);
+    let (nodes, tris) = (&scene.nodes[..], &scene.triangles[..]);
+    let mut radiance = Vec3::ZERO;
+    let mut beta = Vec3::ONE;
+    let mut ray = camera_ray;
+    let mut depth = 0u32;
+    let mut prev_pdf = 0.0f32;
+    let mut prev_delta = true;
+    loop {
+        let hit = intersect_closest(nodes, tris, &ray);
+        depth += 1;
+        if hit.tri == NO_HIT {
+            radiance += beta * Vec3::from(params.environment);
+            break;
+        }
+        let tri = &tris[hit.tri as usize];
+        let m = &scene.materials[tri.material as usize];
+        let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
+        let point = Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2;
+        let ng_raw = e1.cross(e2).normalize();
+        let cos_hit = ray.dir.dot(ng_raw);
+        let emission = Vec3::from(m.emission);
+
+        if cos_hit < 0.0 && emission.max_element() > 0.0 {
+            let mut w = 1.0;
+            if depth > 1 && !prev_delta {
+                match strategy {
+                    Strategy::Light => w = 0.0,
+                    Strategy::Bsdf => {}
+                    _ => w = mis_weight(strategy, prev_pdf, light_pdf(tri, hit.t * hit.t, cos_hit)),
+                }
+            }
+            radiance += beta * emission * w;
+        }
+        if params.max_depth != 0 && depth >= params.max_depth {
+            break;
+        }
+
+        let ng = if cos_hit > 0.0 { -ng_raw } else { ng_raw };
+        let mut ns = shading_normal(scene, tri, hit.tri, hit.u, hit.v, ng_raw);
+        if ns.dot(ray.dir) > 0.0 {
+            ns = -ns;
+        }
+        let frame = frame_from_normal(ns);
+        let wo = to_local(&frame, -ray.dir);
+        let origin = offset_ray(point, ng);
+
+        if strategy != Strategy::Bsdf && params.light_count > 0 {
+            let u0 = rng_next(rng);
+            let u12 = rng_next2(rng);
+            let ls = sample_light(scene, point, Vec3::new(u0, u12.x, u12.y));
+            if ls.pdf > 0.0 {
+                let target = offset_ray(ls.point, ls.normal);
+                let wi = (ls.point - point).normalize();
+                let wi_local = to_local(&frame, wi);
+                let f = bsdf_eval(m, wo, wi_local);
+                if wi.dot(ng) > 0.0
+                    && f.max_element() > 0.0
+                    && !occluded(nodes, tris, &Ray { origin, dir: target - origin }, 1.0)
+                {
+                    let w = if strategy == Strategy::Light {
+                        1.0
+                    } else {
+                        mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, wi_local))
+                    };
+                    radiance += beta * f * wi_local.z.abs() * ls.radiance * (w / ls.pdf);
+                }
+            }
+        }
+
+        let u0 = rng_next(rng);
+        let u12 = rng_next2(rng);
+        let bs = bsdf_sample(m, wo, Vec3::new(u0, u12.x, u12.y));
+        if bs.pdf <= 0.0 {
+            break;
+        }
+        let wi = from_local(&frame, bs.wi);
+        if wi.dot(ng) <= 0.0 {
+            break;
+        }
+        beta *= bs.weight;
+        if beta.max_element() <= 0.0 {
+            break;
+        }
+        prev_pdf = bs.pdf;
+        prev_delta = bs.delta;
+        ray = Ray { origin, dir: wi };
+
+        if depth >= params.rr_depth {
+            let q = beta.max_element().min(0.95);
+            if rng_next(rng) >= q {
+                break;
+            }
+            beta /= q;
+        }
+    }
+    radiance
+}
+
+/// One sample for one film pixel; returns the radiance (possibly non-finite).
+pub fn render_sample(scene: &PackedScene, params: &Params, x: u32, y: u32) -> Vec3 {
+    let pixel = UVec2::new(x + params.tile_x, y + params.tile_y);
+    let mut rng = rng_init(pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
+    let ray = generate_ray(params, pixel, rng_next2(&mut rng));
+    li(scene, params, ray, &mut rng)
+}

@@ -1,0 +1,16 @@
+//! The CPU reference backend: the same integrator as `shaders/`, one file per concept with
+//! the same function names, run over pixels with rayon. It reads the same `PackedScene`,
+//! draws the same random numbers and writes the same film, so GPU results can be checked
+//! against it sample for sample in distribution.
+
+pub mod bsdf;
+pub mod bvh;
+pub mod camera;
+pub mod frame;
+pub mod integrator;
+pub mod lights;
+pub mod mis;
+pub mod rng;
+pub mod sampling;
+
+pub use integrator::render_sample;

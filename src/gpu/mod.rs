@@ -1,0 +1,313 @@
+//! The GPU backend: device selection, the packed scene in buffers, and the progressive
+//! one-sample-per-dispatch kernel.
+
+pub mod shaders;
+
+use crate::Error;
+use crate::film::{FLOATS_PER_PIXEL, Film};
+use crate::packed::PackedScene;
+use crate::params::Params;
+use std::sync::{Arc, Mutex};
+use wgpu::util::DeviceExt;
+
+pub const NO_ADAPTER_HINT: &str =
+    "no Vulkan adapter found; for the GPU path install a Vulkan driver (Debian/Ubuntu: apt-get install mesa-vulkan-drivers)";
+
+fn instance() -> wgpu::Instance {
+    wgpu::Instance::new(wgpu::InstanceDescriptor {
+        backends: wgpu::Backends::VULKAN.with_env(),
+        flags: wgpu::InstanceFlags::empty().with_env(),
+        ..wgpu::InstanceDescriptor::new_without_display_handle()
+    })
+}
+
+/// Every Vulkan adapter found, with its limits.
+pub fn adapters() -> Vec<(wgpu::AdapterInfo, wgpu::Limits)> {
+    let inst = instance();
+    pollster::block_on(inst.enumerate_adapters(wgpu::Backends::VULKAN.with_env()))
+        .iter()
+        .map(|a| (a.get_info(), a.limits()))
+        .collect()
+}
+
+/// A device and queue, with wgpu errors captured instead of panicking.
+pub struct GpuContext {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    errors: Arc<Mutex<Option<String>>>,
+}
+
+impl GpuContext {
+    pub fn new() -> Result<GpuContext, Error> {
+        let inst = instance();
+        // WGPU_ADAPTER_NAME picks an adapter by name; an unmatched name is our error, not a panic.
+        let wanted = std::env::var("WGPU_ADAPTER_NAME").ok().map(|s| s.to_lowercase());
+        let adapter = match wanted {
+            Some(name) => pollster::block_on(inst.enumerate_adapters(wgpu::Backends::VULKAN.with_env()))
+                .into_iter()
+                .find(|a| a.get_info().name.to_lowercase().contains(&name))
+                .ok_or_else(|| Error::NoAdapter(format!("no Vulkan adapter matches WGPU_ADAPTER_NAME={name}")))?,
+            None => pollster::block_on(inst.request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                ..Default::default()
+            }))
+            .map_err(|_| Error::NoAdapter(NO_ADAPTER_HINT.to_string()))?,
+        };
+        let info = adapter.get_info();
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("veach"),
+            required_limits: limits,
+            ..Default::default()
+        }))
+        .map_err(|e| Error::Gpu(format!("cannot open {}: {e}", info.name)))?;
+        let errors = Arc::new(Mutex::new(None));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut slot) = sink.lock() {
+                slot.get_or_insert_with(|| e.to_string());
+            }
+        }));
+        let lost = errors.clone();
+        device.set_device_lost_callback(move |_reason, msg| {
+            if let Ok(mut slot) = lost.lock() {
+                slot.get_or_insert_with(|| format!("device lost: {msg}"));
+            }
+        });
+        Ok(GpuContext { device, queue, info, errors })
+    }
+
+    fn check(&self) -> Result<(), Error> {
+        match self.errors.lock().ok().and_then(|mut e| e.take()) {
+            Some(msg) => Err(Error::Gpu(msg)),
+            None => Ok(()),
+        }
+    }
+
+    pub fn adapter_name(&self) -> String {
+        format!("{} ({:?}, {})", self.info.name, self.info.device_type, self.info.driver)
+    }
+}
+
+/// Samples per submission: enough to amortise the submit, few enough to stay responsive.
+pub const MAX_BATCH: u32 = 64;
+
+pub struct GpuRenderer {
+    ctx: GpuContext,
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    params_buf: wgpu::Buffer,
+    film_buf: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    stride: u64,
+    params: Params,
+    /// Bytes of device memory held (scene + film).
+    pub gpu_bytes: u64,
+}
+
+impl GpuRenderer {
+    pub fn new(ctx: GpuContext, scene: &PackedScene, params: Params) -> Result<GpuRenderer, Error> {
+        let device = &ctx.device;
+        let limits = device.limits();
+        let pixels = params.film_width as u64 * params.film_height as u64;
+        let film_bytes = pixels * (FLOATS_PER_PIXEL * 4) as u64;
+
+        let storage = |label: &str, bytes: &[u8]| -> Result<wgpu::Buffer, Error> {
+            let len = bytes.len() as u64;
+            check_limit(label, len, limits.max_storage_buffer_binding_size, "max_storage_buffer_binding_size")?;
+            check_limit(label, len, limits.max_buffer_size, "max_buffer_size")?;
+            // Zero-sized bindings are invalid; an empty array gets one zeroed element.
+            let padded;
+            let contents = if bytes.is_empty() {
+                padded = vec![0u8; 16];
+                &padded[..]
+            } else {
+                bytes
+            };
+            Ok(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE,
+            }))
+        };
+        let nodes = storage("bvh nodes", bytemuck::cast_slice(&scene.nodes))?;
+        let triangles = storage("triangles", bytemuck::cast_slice(&scene.triangles))?;
+        let normals = storage("normals", bytemuck::cast_slice(&scene.normals))?;
+        let materials = storage("materials", bytemuck::cast_slice(&scene.materials))?;
+        let lights = storage("lights", bytemuck::cast_slice(&scene.lights))?;
+        check_limit("film", film_bytes, limits.max_storage_buffer_binding_size, "max_storage_buffer_binding_size")?;
+        let film_buf = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("film"),
+            size: film_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("film readback"),
+            size: film_bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let params_size = std::mem::size_of::<Params>() as u64;
+        let stride = params_size.next_multiple_of(limits.min_uniform_buffer_offset_alignment as u64);
+        let params_buf = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: stride * MAX_BATCH as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+
+        let source = shaders::compose(shaders::INTEGRATOR).map_err(Error::Gpu)?;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("integrator"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let storage_entry = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(params_size),
+                    },
+                    count: None,
+                },
+                storage_entry(1, true),
+                storage_entry(2, true),
+                storage_entry(3, true),
+                storage_entry(4, true),
+                storage_entry(5, true),
+                storage_entry(6, false),
+            ],
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &params_buf,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(params_size),
+                    }),
+                },
+                wgpu::BindGroupEntry { binding: 1, resource: nodes.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: triangles.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: normals.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: materials.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: lights.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 6, resource: film_buf.as_entire_binding() },
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("integrator"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("integrator"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("render_sample"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let gpu_bytes = [&nodes, &triangles, &normals, &materials, &lights, &film_buf, &params_buf]
+            .iter()
+            .map(|b| b.size())
+            .sum::<u64>();
+        ctx.check()?;
+        Ok(GpuRenderer { ctx, pipeline, bind_group, params_buf, film_buf, readback, stride, params, gpu_bytes })
+    }
+
+    pub fn adapter_name(&self) -> String {
+        self.ctx.adapter_name()
+    }
+
+    /// Renders sample indices `start .. start + count` (one dispatch each) and waits.
+    pub fn render_samples(&mut self, start: u32, count: u32) -> Result<(), Error> {
+        let mut done = 0;
+        while done < count {
+            let batch = (count - done).min(MAX_BATCH);
+            let mut data = vec![0u8; (self.stride * batch as u64) as usize];
+            for k in 0..batch {
+                let mut p = self.params;
+                p.sample_index = start + done + k;
+                let at = (self.stride * k as u64) as usize;
+                data[at..at + std::mem::size_of::<Params>()].copy_from_slice(bytemuck::bytes_of(&p));
+            }
+            self.ctx.queue.write_buffer(&self.params_buf, 0, &data);
+            let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&self.pipeline);
+                for k in 0..batch {
+                    pass.set_bind_group(0, &self.bind_group, &[(self.stride * k as u64) as u32]);
+                    pass.dispatch_workgroups(self.params.film_width.div_ceil(8), self.params.film_height.div_ceil(8), 1);
+                }
+            }
+            let index = self.ctx.queue.submit([encoder.finish()]);
+            self.wait(index)?;
+            done += batch;
+        }
+        Ok(())
+    }
+
+    fn wait(&self, index: wgpu::SubmissionIndex) -> Result<(), Error> {
+        self.ctx
+            .device
+            .poll(wgpu::PollType::Wait { submission_index: Some(index), timeout: None })
+            .map_err(|e| Error::Gpu(format!("waiting for the GPU: {e}")))?;
+        self.ctx.check()
+    }
+
+    /// Replaces the film on the device (resume, or a fresh start).
+    pub fn upload_film(&mut self, film: &Film) {
+        self.ctx.queue.write_buffer(&self.film_buf, 0, bytemuck::cast_slice(&film.data));
+    }
+
+    pub fn read_film(&self) -> Result<Film, Error> {
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&self.film_buf, 0, &self.readback, 0, self.film_buf.size());
+        let index = self.ctx.queue.submit([encoder.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        self.readback.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait(index)?;
+        rx.recv()
+            .map_err(|_| Error::Gpu("film readback was dropped".into()))?
+            .map_err(|e| Error::Gpu(format!("film readback: {e}")))?;
+        let mut film = Film::new(self.params.film_width, self.params.film_height);
+        {
+            let view = self.readback.slice(..).get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?;
+            film.data.copy_from_slice(bytemuck::cast_slice(&view));
+        }
+        self.readback.unmap();
+        Ok(film)
+    }
+}
+
+fn check_limit(what: &str, bytes: u64, limit: u64, name: &str) -> Result<(), Error> {
+    if bytes > limit {
+        return Err(Error::Limit(format!(
+            "the {what} buffer needs {bytes} bytes, above the device limit {name} = {limit}"
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,54 @@
+//! The include step: `#include "file.wgsl"` pulls a file in once (later includes of the same
+//! file are dropped), so every shader file can name what it needs and still compose.
+
+/// All shader sources, embedded so the binary runs from any directory.
+pub const SOURCES: &[(&str, &str)] = &[
+    ("common.wgsl", include_str!("../../shaders/common.wgsl")),
+    ("bindings.wgsl", include_str!("../../shaders/bindings.wgsl")),
+    ("rng.wgsl", include_str!("../../shaders/rng.wgsl")),
+    ("sampling.wgsl", include_str!("../../shaders/sampling.wgsl")),
+    ("frame.wgsl", include_str!("../../shaders/frame.wgsl")),
+    ("mis.wgsl", include_str!("../../shaders/mis.wgsl")),
+    ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
+    ("camera.wgsl", include_str!("../../shaders/camera.wgsl")),
+    ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
+    ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
+    ("integrator.wgsl", include_str!("../../shaders/integrator.wgsl")),
+];
+
+/// The kernel's entry file.
+pub const INTEGRATOR: &str = "integrator.wgsl";
+
+/// Composes `entry` and everything it includes into one WGSL source.
+pub fn compose(entry: &str) -> Result<String, String> {
+    let mut out = String::new();
+    let mut included = Vec::new();
+    include(entry, &mut included, &mut out, 0)?;
+    Ok(out)
+}
+
+fn include(name: &str, included: &mut Vec<String>, out: &mut String, depth: usize) -> Result<(), String> {
+    if included.iter().any(|n| n == name) {
+        return Ok(());
+    }
+    if depth > 32 {
+        return Err(format!("{name}: includes nest deeper than 32"));
+    }
+    let source = SOURCES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, s)| *s)
+        .ok_or_else(|| format!("no shader named {name}"))?;
+    included.push(name.to_string());
+    out.push_str(&format!("// ---- {name}\n"));
+    for line in source.lines() {
+        match line.trim().strip_prefix("#include") {
+            Some(rest) => include(rest.trim().trim_matches('"'), included, out, depth + 1)?,
+            None => {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,254 @@
+//! veach: a physically based path tracer built around multiple importance sampling.
+//!
+//! Data flows one way: glTF → [`scene::Scene`] → [`packed::PackedScene`] (the buffers) →
+//! a backend ([`gpu`] or the [`cpu`] reference) → [`film::Film`] → PNG/EXR.
+//! The CLI, the tests and (later) the viewer all drive [`Renderer`].
+
+pub mod accel;
+pub mod cpu;
+pub mod film;
+pub mod gpu;
+pub mod output;
+pub mod packed;
+pub mod params;
+pub mod scene;
+
+use film::Film;
+use glam::Vec3;
+use packed::PackedScene;
+use params::Params;
+use rayon::prelude::*;
+use std::fmt;
+
+/// Every error veach reports to a user: one line, naming the file or limit at fault.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Error {
+    /// Bad input: a file, a flag, an output path.
+    Input(String),
+    /// No usable Vulkan adapter.
+    NoAdapter(String),
+    /// A device limit would be exceeded.
+    Limit(String),
+    /// The GPU reported an error.
+    Gpu(String),
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Input(m) | Error::NoAdapter(m) | Error::Limit(m) => write!(f, "{m}"),
+            Error::Gpu(m) => write!(f, "GPU error: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// The four direct-lighting estimators of the seed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[repr(u32)]
+pub enum Strategy {
+    /// BSDF sampling only: emission counts when a BSDF-sampled ray hits an emitter.
+    Bsdf = 0,
+    /// Light sampling only: BSDF rays continue the path but their emitter hits count nothing.
+    Light = 1,
+    /// One light and one BSDF sample, weighted by the balance heuristic.
+    MisBalance = 2,
+    /// One light and one BSDF sample, weighted by the power heuristic.
+    MisPower = 3,
+}
+
+impl Strategy {
+    pub fn from_u32(v: u32) -> Strategy {
+        match v {
+            0 => Strategy::Bsdf,
+            1 => Strategy::Light,
+            2 => Strategy::MisBalance,
+            _ => Strategy::MisPower,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Backend {
+    Gpu,
+    Cpu,
+}
+
+/// A crop window of the image (the whole image by default).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tile {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+#[derive(Clone, Debug)]
+pub struct Settings {
+    pub width: u32,
+    pub height: u32,
+    pub max_depth: u32,
+    pub seed: u32,
+    pub strategy: Strategy,
+    pub camera: Option<String>,
+    /// Overrides the scene's environment radiance.
+    pub environment: Option<Vec3>,
+    pub tile: Option<Tile>,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            width: 512,
+            height: 512,
+            max_depth: 8,
+            seed: 0,
+            strategy: Strategy::MisPower,
+            camera: None,
+            environment: None,
+            tile: None,
+        }
+    }
+}
+
+/// Largest image side we accept (a GPU texture/dispatch-friendly bound).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+enum Engine {
+    Gpu(Box<gpu::GpuRenderer>),
+    Cpu(Film),
+}
+
+/// A scene ready to render with one backend, accumulating samples progressively.
+pub struct Renderer {
+    scene: PackedScene,
+    params: Params,
+    engine: Engine,
+}
+
+impl Renderer {
+    /// Prepares `scene` for rendering on `backend`.
+    pub fn new(scene: PackedScene, camera: &scene::Camera, settings: &Settings, backend: Backend) -> Result<Renderer, Error> {
+        Self::with_gpu(scene, camera, settings, backend, None)
+    }
+
+    /// As `new`, reusing an open GPU context when given.
+    pub fn with_gpu(
+        scene: PackedScene,
+        camera: &scene::Camera,
+        settings: &Settings,
+        backend: Backend,
+        ctx: Option<gpu::GpuContext>,
+    ) -> Result<Renderer, Error> {
+        let (w, h) = (settings.width, settings.height);
+        if w == 0 || h == 0 || w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE {
+            return Err(Error::Limit(format!("image size {w}x{h} is outside 1..={MAX_IMAGE_SIDE} per side")));
+        }
+        let tile = settings.tile.unwrap_or(Tile { x: 0, y: 0, width: w, height: h });
+        if tile.width == 0 || tile.height == 0 || tile.x + tile.width > w || tile.y + tile.height > h {
+            return Err(Error::Input(format!(
+                "tile {},{},{},{} does not fit in the {w}x{h} image",
+                tile.x, tile.y, tile.width, tile.height
+            )));
+        }
+        let env = settings.environment.unwrap_or(scene.environment);
+        let params = Params::new(
+            camera,
+            (w, h),
+            tile,
+            settings.seed,
+            settings.max_depth,
+            settings.strategy,
+            env,
+            scene.lights.len() as u32,
+        );
+        let engine = match backend {
+            Backend::Cpu => Engine::Cpu(Film::new(tile.width, tile.height)),
+            Backend::Gpu => {
+                let ctx = match ctx {
+                    Some(c) => c,
+                    None => gpu::GpuContext::new()?,
+                };
+                Engine::Gpu(Box::new(gpu::GpuRenderer::new(ctx, &scene, params)?))
+            }
+        };
+        Ok(Renderer { scene, params, engine })
+    }
+
+    pub fn backend(&self) -> Backend {
+        match self.engine {
+            Engine::Gpu(_) => Backend::Gpu,
+            Engine::Cpu(_) => Backend::Cpu,
+        }
+    }
+
+    pub fn adapter_name(&self) -> String {
+        match &self.engine {
+            Engine::Gpu(g) => g.adapter_name(),
+            Engine::Cpu(_) => format!("cpu ({} threads)", rayon::current_num_threads()),
+        }
+    }
+
+    pub fn scene(&self) -> &PackedScene {
+        &self.scene
+    }
+
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    pub fn gpu_bytes(&self) -> u64 {
+        match &self.engine {
+            Engine::Gpu(g) => g.gpu_bytes,
+            Engine::Cpu(_) => 0,
+        }
+    }
+
+    /// Accumulates sample indices `start .. start + count` into the film.
+    pub fn render_samples(&mut self, start: u32, count: u32) -> Result<(), Error> {
+        match &mut self.engine {
+            Engine::Gpu(g) => g.render_samples(start, count),
+            Engine::Cpu(film) => {
+                let (scene, base) = (&self.scene, self.params);
+                let width = base.film_width as usize;
+                film.data.par_chunks_mut(width * film::FLOATS_PER_PIXEL).enumerate().for_each(|(y, row)| {
+                    let mut row_film = Film { width: base.film_width, height: 1, data: row.to_vec() };
+                    for s in start..start + count {
+                        let mut p = base;
+                        p.sample_index = s;
+                        for x in 0..width {
+                            let l = cpu::render_sample(scene, &p, x as u32, y as u32);
+                            row_film.add_sample(x, l);
+                        }
+                    }
+                    row.copy_from_slice(&row_film.data);
+                });
+                Ok(())
+            }
+        }
+    }
+
+    /// The accumulated film (a readback on the GPU).
+    pub fn film(&self) -> Result<Film, Error> {
+        match &self.engine {
+            Engine::Gpu(g) => g.read_film(),
+            Engine::Cpu(film) => Ok(film.clone()),
+        }
+    }
+
+    /// Replaces the accumulated film (resume).
+    pub fn set_film(&mut self, film: &Film) {
+        match &mut self.engine {
+            Engine::Gpu(g) => g.upload_film(film),
+            Engine::Cpu(f) => *f = film.clone(),
+        }
+    }
+}
+
+/// Loads a glTF file into a packed scene and the chosen camera.
+pub fn load(path: &std::path::Path, camera: Option<&str>) -> Result<(scene::Scene, scene::Camera), Error> {
+    let scene = scene::gltf::load(path)?;
+    let cam = scene.camera(camera).map_err(|e| Error::Input(format!("{}: {e}", path.display())))?;
+    Ok((scene, cam))
+}

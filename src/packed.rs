@@ -1,0 +1,248 @@
+//! The packed scene: the exact buffers the GPU reads, and the CPU reference reads too.
+//!
+//! Every struct here has a twin in `shaders/common.wgsl` with the same field order
+//! (std430 layout, 16-byte aligned rows).
+
+use crate::accel;
+use crate::scene::{Material, Scene};
+use bytemuck::{Pod, Zeroable};
+use glam::{Vec2, Vec3};
+
+/// BVH2 node: an inner node's children are `index` and `index + 1`; a leaf (`count > 0`)
+/// holds triangles `index .. index + count`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct BvhNode {
+    pub min: [f32; 3],
+    pub index: u32,
+    pub max: [f32; 3],
+    pub count: u32,
+}
+
+/// A triangle as intersected: vertex 0 and two edges (Möller–Trumbore form).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct PackedTriangle {
+    pub p0: [f32; 3],
+    pub material: u32,
+    pub e1: [f32; 3],
+    /// Probability of picking this triangle in light sampling divided by its area
+    /// (the area-measure light pdf); 0 when it is not a light.
+    pub light_pdf_area: f32,
+    pub e2: [f32; 3],
+    /// Bit 0: has vertex normals (else shading normal = geometric normal).
+    pub flags: u32,
+}
+
+pub const TRI_HAS_NORMALS: u32 = 1;
+
+/// Octahedron-encoded vertex normals (`pack2x16snorm`), one per vertex.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct PackedNormals {
+    pub n: [u32; 3],
+    pub pad: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct PackedMaterial {
+    pub base_color: [f32; 3],
+    pub metallic: f32,
+    pub emission: [f32; 3],
+    pub roughness: f32,
+    /// specularColor × specularFactor (KHR_materials_specular), the dielectric F0 tint.
+    pub specular: [f32; 3],
+    pub ior: f32,
+}
+
+/// One entry of the light alias table (Vose): pick entry `i` uniformly, keep it with
+/// probability `prob`, else take `alias`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct LightEntry {
+    pub triangle: u32,
+    pub alias_slot: u32,
+    pub prob: f32,
+    /// Probability that this light is chosen (for reference and tests).
+    pub pmf: f32,
+}
+
+pub struct PackedScene {
+    pub nodes: Vec<BvhNode>,
+    pub triangles: Vec<PackedTriangle>,
+    pub normals: Vec<PackedNormals>,
+    pub materials: Vec<PackedMaterial>,
+    pub lights: Vec<LightEntry>,
+    /// Original scene index of each packed triangle.
+    pub order: Vec<u32>,
+    pub bvh_build_seconds: f64,
+    pub environment: Vec3,
+    /// Scene bounds' diagonal length (scale for ray epsilons where needed).
+    pub extent: f32,
+}
+
+impl PackedScene {
+    pub fn new(scene: &Scene) -> PackedScene {
+        let verts: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.positions).collect();
+        let bvh = accel::build(&verts);
+        let ordered: Vec<&crate::scene::Triangle> =
+            bvh.order.iter().map(|&i| &scene.triangles[i as usize]).collect();
+
+        let materials: Vec<PackedMaterial> = scene.materials.iter().map(pack_material).collect();
+
+        // Lights: emissive triangles with positive area, chosen proportional to power.
+        let mut light_tris = Vec::new();
+        let mut weights = Vec::new();
+        for (i, t) in ordered.iter().enumerate() {
+            let m = &scene.materials[t.material as usize];
+            let area = t.area();
+            let power = area * luminance(m.emission);
+            if m.is_emissive() && area > 0.0 && power.is_finite() && power > 0.0 {
+                light_tris.push(i as u32);
+                weights.push(power as f64);
+            }
+        }
+        let lights = build_alias_table(&light_tris, &weights);
+        let mut light_pdf = vec![0.0f32; ordered.len()];
+        for l in &lights {
+            let area = ordered[l.triangle as usize].area();
+            light_pdf[l.triangle as usize] = l.pmf / area;
+        }
+
+        let triangles = ordered
+            .iter()
+            .zip(&light_pdf)
+            .map(|(t, &pdf)| {
+                let [p0, p1, p2] = t.positions;
+                let ng = t.cross().normalize_or_zero();
+                let flat = t.normals.iter().all(|n| n.dot(ng) > 0.99999);
+                PackedTriangle {
+                    p0: p0.into(),
+                    material: t.material,
+                    e1: (p1 - p0).into(),
+                    light_pdf_area: pdf,
+                    e2: (p2 - p0).into(),
+                    flags: if flat { 0 } else { TRI_HAS_NORMALS },
+                }
+            })
+            .collect();
+        let normals = ordered
+            .iter()
+            .map(|t| PackedNormals { n: t.normals.map(oct_encode), pad: 0 })
+            .collect();
+        let bounds = scene.bounds();
+        let extent = if bounds.is_empty() { 1.0 } else { bounds.diagonal().length() };
+        PackedScene {
+            nodes: bvh.nodes,
+            triangles,
+            normals,
+            materials,
+            lights,
+            order: bvh.order,
+            bvh_build_seconds: bvh.build_seconds,
+            environment: scene.environment,
+            extent,
+        }
+    }
+}
+
+pub fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+fn pack_material(m: &Material) -> PackedMaterial {
+    PackedMaterial {
+        base_color: m.base_color.into(),
+        metallic: m.metallic,
+        emission: m.emission.into(),
+        roughness: m.roughness,
+        specular: (m.specular_color * m.specular_factor).into(),
+        ior: m.ior,
+    }
+}
+
+/// Vose's alias method: O(1) sampling of a discrete distribution, built in f64.
+fn build_alias_table(items: &[u32], weights: &[f64]) -> Vec<LightEntry> {
+    let n = items.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let total: f64 = weights.iter().sum();
+    let mut scaled: Vec<f64> = weights.iter().map(|w| w * n as f64 / total).collect();
+    let mut alias: Vec<usize> = (0..n).collect();
+    let mut prob = vec![1.0f64; n];
+    let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
+    while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
+        prob[s] = scaled[s];
+        alias[s] = l;
+        scaled[l] -= 1.0 - scaled[s];
+        if scaled[l] < 1.0 {
+            large.pop();
+            small.push(l);
+        }
+    }
+    (0..n)
+        .map(|i| LightEntry {
+            triangle: items[i],
+            alias_slot: alias[i] as u32,
+            prob: prob[i] as f32,
+            pmf: (weights[i] / total) as f32,
+        })
+        .collect()
+}
+
+/// Octahedral normal encoding into `pack2x16snorm` bits (decoded by `oct_decode`).
+pub fn oct_encode(n: Vec3) -> u32 {
+    let n = n / (n.x.abs() + n.y.abs() + n.z.abs()).max(1e-30);
+    let mut e = Vec2::new(n.x, n.y);
+    if n.z < 0.0 {
+        let s = Vec2::new(if n.x >= 0.0 { 1.0 } else { -1.0 }, if n.y >= 0.0 { 1.0 } else { -1.0 });
+        e = (Vec2::ONE - Vec2::new(n.y.abs(), n.x.abs())) * s;
+    }
+    let q = |v: f32| ((v.clamp(-1.0, 1.0) * 32767.0).round() as i16) as u16 as u32;
+    q(e.x) | (q(e.y) << 16)
+}
+
+/// WGSL's `unpack2x16snorm` followed by the octahedral decode.
+pub fn oct_decode(bits: u32) -> Vec3 {
+    let u = |b: u32| ((b as u16 as i16) as f32 / 32767.0).max(-1.0);
+    let (x, y) = (u(bits & 0xffff), u(bits >> 16));
+    let z = 1.0 - x.abs() - y.abs();
+    let t = (-z).max(0.0);
+    let x = x + if x >= 0.0 { -t } else { t };
+    let y = y + if y >= 0.0 { -t } else { t };
+    Vec3::new(x, y, z).normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn alias_table_reproduces_weights() {
+        let w = [1.0, 2.0, 3.0, 10.0, 0.5];
+        let t = build_alias_table(&[0, 1, 2, 3, 4], &w);
+        let n = t.len() as f64;
+        let mut p = [0.0f64; 5];
+        for (i, e) in t.iter().enumerate() {
+            p[i] += e.prob as f64 / n;
+            p[e.alias_slot as usize] += (1.0 - e.prob as f64) / n;
+        }
+        let total: f64 = w.iter().sum();
+        for i in 0..5 {
+            assert!((p[i] - w[i] / total).abs() < 1e-6, "{i}: {} vs {}", p[i], w[i] / total);
+        }
+    }
+
+    #[test]
+    fn octahedral_normals_round_trip() {
+        for i in 0..1000 {
+            let a = i as f32 * 0.37;
+            let b = (i as f32 * 0.11).sin();
+            let n = Vec3::new(a.cos() * (1.0 - b * b).sqrt(), a.sin() * (1.0 - b * b).sqrt(), b).normalize();
+            let d = oct_decode(oct_encode(n));
+            assert!(d.dot(n) > 0.99999, "{n} -> {d}");
+        }
+    }
+}
