@@ -129,7 +129,12 @@ pub struct Renderer {
 
 impl Renderer {
     /// Prepares `scene` for rendering on `backend`.
-    pub fn new(scene: PackedScene, camera: &scene::Camera, settings: &Settings, backend: Backend) -> Result<Renderer, Error> {
+    pub fn new(
+        scene: PackedScene,
+        camera: &scene::Camera,
+        settings: &Settings,
+        backend: Backend,
+    ) -> Result<Renderer, Error> {
         Self::with_gpu(scene, camera, settings, backend, None)
     }
 

@@ -8,7 +8,11 @@ use std::time::Instant;
 use veach::{Backend, Error, Renderer, Settings, Strategy};
 
 #[derive(Parser)]
-#[command(name = "veach", version, about = "A physically based GPU path tracer built around multiple importance sampling")]
+#[command(
+    name = "veach",
+    version,
+    about = "A physically based GPU path tracer built around multiple importance sampling"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -65,10 +69,8 @@ struct RenderArgs {
 }
 
 fn parse_rgb(s: &str) -> Result<Vec3, String> {
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f32>().map_err(|e| format!("'{x}': {e}")))
-        .collect::<Result<_, _>>()?;
+    let v: Vec<f32> =
+        s.split(',').map(|x| x.trim().parse::<f32>().map_err(|e| format!("'{x}': {e}"))).collect::<Result<_, _>>()?;
     match v[..] {
         [r, g, b] if v.iter().all(|c| c.is_finite() && *c >= 0.0) => Ok(Vec3::new(r, g, b)),
         [c] if c.is_finite() && c >= 0.0 => Ok(Vec3::splat(c)),
@@ -77,6 +79,7 @@ fn parse_rgb(s: &str) -> Result<Vec3, String> {
 }
 
 fn main() -> ExitCode {
+    quiet_vulkan_loader();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render(&args),
@@ -91,13 +94,33 @@ fn main() -> ExitCode {
     }
 }
 
+/// Mesa's window-system code complains on every device creation when XDG_RUNTIME_DIR is
+/// unset (headless machines, CI); give it a private directory before any thread starts.
+fn quiet_vulkan_loader() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        let dir = std::env::temp_dir().join("veach-xdg-runtime");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::DirBuilderExt;
+            let _ = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        }
+        if dir.is_dir() {
+            // SAFETY: called first thing in main, before any other thread exists.
+            unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+        }
+    }
+}
+
 fn info() -> Result<(), Error> {
     let adapters = veach::gpu::adapters();
     if adapters.is_empty() {
         return Err(Error::NoAdapter(veach::gpu::NO_ADAPTER_HINT.into()));
     }
     for (info, limits) in adapters {
-        println!("{} ({:?}, {:?}, driver {} {})", info.name, info.device_type, info.backend, info.driver, info.driver_info);
+        println!(
+            "{} ({:?}, {:?}, driver {} {})",
+            info.name, info.device_type, info.backend, info.driver, info.driver_info
+        );
         println!("  max_storage_buffer_binding_size {}", limits.max_storage_buffer_binding_size);
         println!("  max_buffer_size {}", limits.max_buffer_size);
         println!("  max_texture_dimension_2d {}", limits.max_texture_dimension_2d);
@@ -122,7 +145,10 @@ fn render(args: &RenderArgs) -> Result<(), Error> {
     let (scene, camera) = veach::load(&args.scene, args.camera.as_deref())?;
     let triangles = scene.triangles.len();
     if scene.emissive_triangle_count() == 0 && scene.environment == Vec3::ZERO && args.env_color.is_none() {
-        eprintln!("veach: warning: {}: the scene has no lights and no environment; the image will be black", args.scene.display());
+        eprintln!(
+            "veach: warning: {}: the scene has no lights and no environment; the image will be black",
+            args.scene.display()
+        );
     }
     let packed = veach::packed::PackedScene::new(&scene);
     let (bvh_nodes, bvh_seconds) = (packed.nodes.len(), packed.bvh_build_seconds);

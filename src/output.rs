@@ -29,8 +29,7 @@ pub fn check_output(path: &Path) -> Result<Format, Error> {
         return Err(Error::Input(format!("{}: is a directory", path.display())));
     }
     let probe = temp_path(path);
-    std::fs::write(&probe, b"")
-        .map_err(|e| Error::Input(format!("{}: cannot write output: {e}", path.display())))?;
+    std::fs::write(&probe, b"").map_err(|e| Error::Input(format!("{}: cannot write output: {e}", path.display())))?;
     let _ = std::fs::remove_file(&probe);
     Ok(format)
 }

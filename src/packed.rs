@@ -86,8 +86,7 @@ impl PackedScene {
     pub fn new(scene: &Scene) -> PackedScene {
         let verts: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.positions).collect();
         let bvh = accel::build(&verts);
-        let ordered: Vec<&crate::scene::Triangle> =
-            bvh.order.iter().map(|&i| &scene.triangles[i as usize]).collect();
+        let ordered: Vec<&crate::scene::Triangle> = bvh.order.iter().map(|&i| &scene.triangles[i as usize]).collect();
 
         let materials: Vec<PackedMaterial> = scene.materials.iter().map(pack_material).collect();
 
@@ -127,10 +126,14 @@ impl PackedScene {
                 }
             })
             .collect();
-        let normals = ordered
-            .iter()
-            .map(|t| PackedNormals { n: t.normals.map(oct_encode), pad: 0 })
-            .collect();
+        let mut triangles: Vec<PackedTriangle> = triangles;
+        if triangles.is_empty() {
+            // The empty BVH's leaf points at one zero-area triangle that no ray hits.
+            triangles.push(PackedTriangle::zeroed());
+        }
+        let mut normals: Vec<PackedNormals> =
+            ordered.iter().map(|t| PackedNormals { n: t.normals.map(oct_encode), pad: 0 }).collect();
+        normals.resize(triangles.len(), PackedNormals::zeroed());
         let bounds = scene.bounds();
         let extent = if bounds.is_empty() { 1.0 } else { bounds.diagonal().length() };
         PackedScene {

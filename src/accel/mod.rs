@@ -17,29 +17,18 @@ pub struct Bvh {
 pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
     let start = Instant::now();
     if triangles.is_empty() {
-        // An inverted box that no ray enters.
-        let node = BvhNode {
-            min: [f32::INFINITY; 3],
-            index: 0,
-            max: [f32::NEG_INFINITY; 3],
-            count: 0,
-        };
+        // One leaf holding one degenerate triangle (added by the packer): rays can enter
+        // it, but a zero-area triangle is never hit, so traversal needs no special case.
+        let node = BvhNode { min: [0.0; 3], index: 0, max: [0.0; 3], count: 1 };
         return Bvh { nodes: vec![node], order: Vec::new(), build_seconds: 0.0 };
     }
-    let tris: Vec<BvhTriangle> = triangles
-        .iter()
-        .map(|t| BvhTriangle { v0: t[0].into(), v1: t[1].into(), v2: t[2].into() })
-        .collect();
+    let tris: Vec<BvhTriangle> =
+        triangles.iter().map(|t| BvhTriangle { v0: t[0].into(), v1: t[1].into(), v2: t[2].into() }).collect();
     let bvh = build_bvh2_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
     let nodes = bvh
         .nodes
         .iter()
-        .map(|n| BvhNode {
-            min: n.aabb.min.into(),
-            index: n.first_index,
-            max: n.aabb.max.into(),
-            count: n.prim_count,
-        })
+        .map(|n| BvhNode { min: n.aabb.min.into(), index: n.first_index, max: n.aabb.max.into(), count: n.prim_count })
         .collect();
     Bvh { nodes, order: bvh.primitive_indices, build_seconds: start.elapsed().as_secs_f64() }
 }

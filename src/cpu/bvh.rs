@@ -115,7 +115,8 @@ pub fn occluded(nodes: &[BvhNode], triangles: &[PackedTriangle], ray: &Ray, t_ma
 
 pub fn offset_ray(p: Vec3, n: Vec3) -> Vec3 {
     let of_i = (256.0 * n).as_ivec3();
-    let bump = |pc: f32, o: i32| f32::from_bits((pc.to_bits() as i32).wrapping_add(if pc < 0.0 { -o } else { o }) as u32);
+    let bump =
+        |pc: f32, o: i32| f32::from_bits((pc.to_bits() as i32).wrapping_add(if pc < 0.0 { -o } else { o }) as u32);
     let p_i = Vec3::new(bump(p.x, of_i.x), bump(p.y, of_i.y), bump(p.z, of_i.z));
     let pick = |pc: f32, pi: f32, nc: f32| if pc.abs() < 1.0 / 32.0 { pc + (1.0 / 65536.0) * nc } else { pi };
     let _: IVec3 = of_i;

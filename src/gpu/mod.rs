@@ -10,8 +10,7 @@ use crate::params::Params;
 use std::sync::{Arc, Mutex};
 use wgpu::util::DeviceExt;
 
-pub const NO_ADAPTER_HINT: &str =
-    "no Vulkan adapter found; for the GPU path install a Vulkan driver (Debian/Ubuntu: apt-get install mesa-vulkan-drivers)";
+pub const NO_ADAPTER_HINT: &str = "no Vulkan adapter found; for the GPU path install a Vulkan driver (Debian/Ubuntu: apt-get install mesa-vulkan-drivers)";
 
 fn instance() -> wgpu::Instance {
     wgpu::Instance::new(wgpu::InstanceDescriptor {
@@ -258,7 +257,11 @@ impl GpuRenderer {
                 pass.set_pipeline(&self.pipeline);
                 for k in 0..batch {
                     pass.set_bind_group(0, &self.bind_group, &[(self.stride * k as u64) as u32]);
-                    pass.dispatch_workgroups(self.params.film_width.div_ceil(8), self.params.film_height.div_ceil(8), 1);
+                    pass.dispatch_workgroups(
+                        self.params.film_width.div_ceil(8),
+                        self.params.film_height.div_ceil(8),
+                        1,
+                    );
                 }
             }
             let index = self.ctx.queue.submit([encoder.finish()]);

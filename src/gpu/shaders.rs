@@ -34,11 +34,8 @@ fn include(name: &str, included: &mut Vec<String>, out: &mut String, depth: usiz
     if depth > 32 {
         return Err(format!("{name}: includes nest deeper than 32"));
     }
-    let source = SOURCES
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, s)| *s)
-        .ok_or_else(|| format!("no shader named {name}"))?;
+    let source =
+        SOURCES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s).ok_or_else(|| format!("no shader named {name}"))?;
     included.push(name.to_string());
     out.push_str(&format!("// ---- {name}\n"));
     for line in source.lines() {

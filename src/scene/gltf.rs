@@ -32,8 +32,7 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
         scene.environment = env;
     }
 
-    let mut stack: Vec<(gltf::Node, Mat4, usize)> =
-        gltf_scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    let mut stack: Vec<(gltf::Node, Mat4, usize)> = gltf_scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     while let Some((node, parent, depth)) = stack.pop() {
         if depth > 256 {
             return Err(fail("node hierarchy deeper than 256 levels (a cycle?)".into()));
@@ -161,10 +160,7 @@ fn load_mesh(
                 idx.swap(1, 2);
             }
             if let Some(bad) = idx.iter().find(|&&i| i as usize >= positions.len()) {
-                return Err(format!(
-                    "{name}: index {bad} is out of range ({} vertices)",
-                    positions.len()
-                ));
+                return Err(format!("{name}: index {bad} is out of range ({} vertices)", positions.len()));
             }
             let p = idx.map(|i| world.transform_point3(positions[i as usize]));
             if !p.iter().all(|v| v.is_finite()) {
@@ -196,9 +192,7 @@ fn triangulate(indices: &[u32], mode: gltf::mesh::Mode) -> Vec<[u32; 3]> {
                 }
             })
             .collect(),
-        Mode::TriangleFan => {
-            (2..indices.len()).map(|i| [indices[0], indices[i - 1], indices[i]]).collect()
-        }
+        Mode::TriangleFan => (2..indices.len()).map(|i| [indices[0], indices[i - 1], indices[i]]).collect(),
         _ => indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
     }
 }

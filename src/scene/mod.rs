@@ -122,9 +122,6 @@ impl Scene {
     }
 
     pub fn emissive_triangle_count(&self) -> usize {
-        self.triangles
-            .iter()
-            .filter(|t| self.materials[t.material as usize].is_emissive() && t.area() > 0.0)
-            .count()
+        self.triangles.iter().filter(|t| self.materials[t.material as usize].is_emissive() && t.area() > 0.0).count()
     }
 }

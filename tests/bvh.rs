@@ -1,0 +1,82 @@
+//! The flattened BVH finds exactly what brute force over all triangles finds.
+
+use glam::Vec3;
+use veach::cpu::bvh::{INF, NO_HIT, Ray, intersect_closest, intersect_triangle, occluded};
+use veach::packed::PackedScene;
+use veach::scene::{Material, Scene, Triangle};
+
+mod common;
+
+/// A small deterministic generator for test inputs (not the renderer's RNG).
+struct Lcg(u64);
+impl Lcg {
+    fn f(&mut self) -> f32 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn v(&mut self) -> Vec3 {
+        Vec3::new(self.f(), self.f(), self.f())
+    }
+}
+
+fn soup(count: usize, rng: &mut Lcg) -> Scene {
+    let triangles = (0..count)
+        .map(|_| {
+            let c = rng.v() * 10.0;
+            let p = [c + rng.v() - 0.5, c + rng.v() - 0.5, c + rng.v() - 0.5];
+            let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+            Triangle { positions: p, normals: [n; 3], material: 0 }
+        })
+        .collect();
+    Scene { triangles, materials: vec![Material::default()], ..Default::default() }
+}
+
+fn check(scene: &Scene, rays: usize, rng: &mut Lcg) {
+    let packed = PackedScene::new(scene);
+    let b = scene.bounds();
+    let (lo, size) = (b.min - 0.2 * b.diagonal(), 1.4 * b.diagonal());
+    let mut hits = 0;
+    for _ in 0..rays {
+        let origin = lo + rng.v() * size;
+        let dir = (rng.v() * 2.0 - 1.0).normalize();
+        let ray = Ray { origin, dir };
+        let bvh = intersect_closest(&packed.nodes, &packed.triangles, &ray);
+        let mut brute = (INF, NO_HIT);
+        for (i, t) in packed.triangles.iter().enumerate() {
+            let r = intersect_triangle(&ray, t);
+            if r.x < brute.0 {
+                brute = (r.x, i as u32);
+            }
+        }
+        // Same triangle code on both sides: the distances agree exactly (ties on shared
+        // edges may name either triangle).
+        assert_eq!(bvh.t.to_bits(), brute.0.to_bits(), "ray {origin} {dir}: bvh {bvh:?} vs brute {brute:?}");
+        if brute.1 != NO_HIT {
+            hits += 1;
+            let tri = &packed.triangles[bvh.tri as usize];
+            assert_eq!(intersect_triangle(&ray, tri).x, bvh.t);
+            // Any-hit agrees: blocked just beyond the hit, free just before it.
+            assert!(occluded(&packed.nodes, &packed.triangles, &ray, bvh.t * 1.0001));
+        } else {
+            assert!(!occluded(&packed.nodes, &packed.triangles, &ray, INF));
+        }
+    }
+    assert!(hits > rays / 20, "the test rays should hit something ({hits}/{rays})");
+}
+
+#[test]
+fn bvh_closest_hit_equals_brute_force() {
+    let mut rng = Lcg(7);
+    check(&soup(3000, &mut rng), 10_000, &mut rng);
+    for name in ["cornell-box.gltf", "furnace-a080.gltf", "veach-mis.gltf"] {
+        let (scene, _) = veach::load(&common::asset(name), None).expect("asset loads");
+        check(&scene, 10_000, &mut rng);
+    }
+}
+
+#[test]
+fn bvh_of_an_empty_scene_misses() {
+    let packed = PackedScene::new(&Scene::default());
+    let ray = Ray { origin: Vec3::ZERO, dir: Vec3::Z };
+    assert_eq!(intersect_closest(&packed.nodes, &packed.triangles, &ray).tri, NO_HIT);
+}

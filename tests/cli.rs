@@ -1,0 +1,137 @@
+//! The command line as a user meets it: bad input gets one line and exit code 2, and never
+//! leaves a partial output file.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+mod common;
+
+fn veach(args: &[&str], envs: &[(&str, &str)]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_veach"));
+    cmd.args(args);
+    for (k, v) in envs {
+        cmd.env(k, v);
+    }
+    cmd.output().expect("run veach")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("veach-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+fn assert_user_error(out: &Output, needle: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {stderr}");
+    assert!(stderr.contains(needle), "expected '{needle}' in: {stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.contains("XDG_RUNTIME_DIR")).collect();
+    assert_eq!(lines.len(), 1, "one line expected: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn bad_inputs_exit_2_with_one_line_and_no_output() {
+    let d = temp_dir("bad");
+    let out_png = d.join("out.png");
+    let out = out_png.to_str().expect("utf8");
+    let cbox = common::asset("cornell-box.gltf");
+    let cbox = cbox.to_str().expect("utf8");
+
+    let missing = d.join("missing.gltf");
+    assert_user_error(&veach(&["render", missing.to_str().unwrap(), "-o", out], &[]), "missing.gltf");
+
+    let broken = d.join("broken.gltf");
+    std::fs::write(&broken, b"{ \"asset\": { \"version\": ").unwrap();
+    assert_user_error(&veach(&["render", broken.to_str().unwrap(), "-o", out], &[]), "broken.gltf");
+
+    let glb = d.join("truncated.glb");
+    std::fs::write(&glb, b"glTF\x02\x00\x00\x00\xff\xff").unwrap();
+    assert_user_error(&veach(&["render", glb.to_str().unwrap(), "-o", out], &[]), "truncated.glb");
+
+    assert_user_error(&veach(&["render", cbox, "-o", d.join("out.jpg").to_str().unwrap()], &[]), "out.jpg");
+    assert_user_error(&veach(&["render", cbox, "-o", d.join("no/such/dir/out.png").to_str().unwrap()], &[]), "out.png");
+    assert_user_error(&veach(&["render", cbox, "-o", out, "--camera", "nope"], &[]), "nope");
+
+    // Leftover files only: the failed runs wrote nothing (broken inputs are ours).
+    let mut left: Vec<String> =
+        std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    left.sort();
+    assert_eq!(left, ["broken.gltf", "truncated.glb"]);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn renders_png_and_exr_with_stats() {
+    let d = temp_dir("ok");
+    let cbox = common::asset("cornell-box.gltf");
+    for name in ["a.png", "a.exr"] {
+        let out = d.join(name);
+        let stats = d.join("stats.json");
+        let r = veach(
+            &[
+                "render",
+                cbox.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--width",
+                "24",
+                "--height",
+                "16",
+                "--spp",
+                "2",
+                "--backend",
+                "cpu",
+                "--stats-json",
+                stats.to_str().unwrap(),
+            ],
+            &[],
+        );
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let img = image::open(&out).expect("readable image");
+        assert_eq!((img.width(), img.height()), (24, 16));
+        let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+        for key in [
+            "scene",
+            "width",
+            "height",
+            "spp",
+            "max_depth",
+            "seed",
+            "adapter",
+            "backend",
+            "seconds_total",
+            "seconds_render",
+            "samples_per_second",
+            "triangles",
+            "bvh_nodes",
+            "bvh_build_seconds",
+        ] {
+            assert!(s.get(key).is_some(), "stats lack {key}: {s}");
+        }
+        assert_eq!(s["triangles"], 32);
+        assert_eq!(s["backend"], "cpu");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn without_a_vulkan_driver_falls_back_to_cpu_or_says_how_to_get_one() {
+    let d = temp_dir("nogpu");
+    let cbox = common::asset("cornell-box.gltf");
+    let out = d.join("a.png");
+    let no_driver = [("VK_DRIVER_FILES", "/nonexistent.json"), ("VK_ICD_FILENAMES", "/nonexistent.json")];
+    let args =
+        ["render", cbox.to_str().unwrap(), "-o", out.to_str().unwrap(), "--width", "8", "--height", "8", "--spp", "1"];
+    let r = veach(&args, &no_driver);
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{stderr}");
+    assert!(stderr.contains("apt-get install mesa-vulkan-drivers") && stderr.contains("CPU"), "{stderr}");
+    assert!(out.exists());
+
+    let mut explicit = args.to_vec();
+    explicit.extend(["--backend", "gpu"]);
+    assert_user_error(&veach(&explicit, &no_driver), "apt-get install mesa-vulkan-drivers");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -1,0 +1,108 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use glam::Vec3;
+use std::path::{Path, PathBuf};
+use veach::film::Film;
+use veach::gpu::GpuContext;
+use veach::{Backend, Error, Renderer, Settings};
+
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+pub fn asset(name: &str) -> PathBuf {
+    root().join("assets").join(name)
+}
+
+/// A GPU context, or None (after saying why) when this machine has no Vulkan adapter.
+/// With VEACH_REQUIRE_GPU=1 (CI) a missing adapter fails the test instead.
+pub fn gpu(test: &str) -> Option<GpuContext> {
+    match GpuContext::new() {
+        Ok(ctx) => Some(ctx),
+        Err(e) => {
+            if std::env::var("VEACH_REQUIRE_GPU").as_deref() == Ok("1") {
+                panic!("{test}: VEACH_REQUIRE_GPU=1 but the GPU is unavailable: {e}");
+            }
+            eprintln!("skipping the GPU part of {test}: {e}");
+            None
+        }
+    }
+}
+
+pub fn settings(size: u32, max_depth: u32, seed: u32) -> Settings {
+    Settings { width: size, height: size, max_depth, seed, ..Settings::default() }
+}
+
+/// Renders `spp` samples of a scene file on a backend (a GPU context selects the GPU).
+pub fn render(scene: &Path, settings: &Settings, spp: u32, ctx: Option<GpuContext>) -> Film {
+    try_render(scene, settings, spp, ctx).unwrap_or_else(|e| panic!("render {}: {e}", scene.display()))
+}
+
+pub fn try_render(scene: &Path, settings: &Settings, spp: u32, ctx: Option<GpuContext>) -> Result<Film, Error> {
+    let (s, camera) = veach::load(scene, settings.camera.as_deref())?;
+    let packed = veach::packed::PackedScene::new(&s);
+    let backend = if ctx.is_some() { Backend::Gpu } else { Backend::Cpu };
+    let mut r = Renderer::with_gpu(packed, &camera, settings, backend, ctx)?;
+    r.render_samples(0, spp)?;
+    r.film()
+}
+
+/// A reference image and its per-pixel standard error from tests/data.
+pub fn reference(name: &str) -> (Vec<Vec3>, Vec<Vec3>) {
+    let read = |file: String| {
+        let (_, _, v) = veach::output::read_exr(&root().join("tests/data").join(file)).expect("reference data");
+        v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect::<Vec<_>>()
+    };
+    (read(format!("{name}_64.exr")), read(format!("{name}_64_stderr.exr")))
+}
+
+/// How an estimate compares with an expected image, pixel by pixel and in the mean.
+#[derive(Debug)]
+pub struct Agreement {
+    /// Relative difference of the image mean, per channel.
+    pub mean_rel: Vec3,
+    /// Difference of the image means divided by its standard error, per channel.
+    pub mean_z: Vec3,
+    /// Fraction of pixel channels with |z| > 4.
+    pub outliers: f64,
+}
+
+/// Compares `a` (with per-pixel variance of its mean `var_a`) with `b` (variance `var_b`).
+/// Pixels whose combined variance is zero must agree to 1e-4 relative, else they count as outliers.
+pub fn agreement(a: &[Vec3], var_a: &[Vec3], b: &[Vec3], var_b: &[Vec3]) -> Agreement {
+    let n = a.len() as f64;
+    let (mut sum_a, mut sum_b, mut var_sum) = ([0f64; 3], [0f64; 3], [0f64; 3]);
+    let mut outliers = 0usize;
+    for i in 0..a.len() {
+        for c in 0..3 {
+            let (x, y) = (a[i][c] as f64, b[i][c] as f64);
+            let v = var_a[i][c] as f64 + var_b[i][c] as f64;
+            sum_a[c] += x;
+            sum_b[c] += y;
+            var_sum[c] += v;
+            let bad = if v > 0.0 {
+                ((x - y) / v.sqrt()).abs() > 4.0
+            } else {
+                (x - y).abs() > 1e-4 * x.abs().max(y.abs()).max(1e-3)
+            };
+            outliers += bad as usize;
+        }
+    }
+    let rel = |c: usize| ((sum_a[c] - sum_b[c]) / sum_b[c].abs().max(1e-12)) as f32;
+    let z = |c: usize| ((sum_a[c] - sum_b[c]) / var_sum[c].sqrt().max(1e-12)) as f32;
+    Agreement {
+        mean_rel: Vec3::new(rel(0), rel(1), rel(2)),
+        mean_z: Vec3::new(z(0), z(1), z(2)),
+        outliers: outliers as f64 / (3.0 * n),
+    }
+}
+
+pub fn film_stats(film: &Film) -> (Vec<Vec3>, Vec<Vec3>) {
+    let n = film.pixel_count();
+    ((0..n).map(|i| film.mean(i)).collect(), (0..n).map(|i| film.variance_of_mean(i)).collect())
+}
+
+pub fn squares(v: &[Vec3]) -> Vec<Vec3> {
+    v.iter().map(|s| *s * *s).collect()
+}

@@ -1,0 +1,143 @@
+//! Renders checked against independent references, analytic values, the other backend,
+//! and themselves (determinism).
+
+mod common;
+
+use common::*;
+use glam::Vec3;
+
+/// 64×64 at 256 spp. Per pixel, z = (ours − reference) / √(our variance of the mean +
+/// reference stderr²). With 256 samples the sample variance of a pixel near the light is
+/// itself noisy (heavy-tailed paths), so |z| > 4 happens more often than a Gaussian's 6e-5:
+/// we allow 0.5 % of pixel channels. A real bias shows in the image mean first: each channel's
+/// mean must be within 2 % and within 5 standard errors of the reference. `detects_bias`
+/// below proves these tolerances reject a 3 % error.
+const SPP: u32 = 256;
+const MAX_OUTLIERS: f64 = 0.005;
+
+fn assert_agrees(what: &str, a: &Agreement) {
+    eprintln!("{what}: {a:?}");
+    assert!(a.mean_rel.abs().max_element() < 0.02, "{what}: image mean off by {:?}", a.mean_rel);
+    assert!(a.mean_z.abs().max_element() < 5.0, "{what}: image mean {:?} standard errors away", a.mean_z);
+    assert!(a.outliers < MAX_OUTLIERS, "{what}: {:.3}% of pixels have |z| > 4", 100.0 * a.outliers);
+}
+
+fn cornell_box_against_reference(ctx: Option<veach::gpu::GpuContext>, what: &str) {
+    let film = render(&asset("cornell-box.gltf"), &settings(64, 8, 1), SPP, ctx);
+    let (mean, var) = film_stats(&film);
+    let (reference, stderr) = reference("cbox_d8");
+    assert_agrees(what, &agreement(&mean, &var, &reference, &squares(&stderr)));
+}
+
+#[test]
+fn cornell_box_matches_reference_cpu() {
+    cornell_box_against_reference(None, "cbox cpu");
+}
+
+#[test]
+fn cornell_box_matches_reference_gpu() {
+    if let Some(ctx) = gpu("cornell_box_matches_reference_gpu") {
+        cornell_box_against_reference(Some(ctx), "cbox gpu");
+    }
+}
+
+#[test]
+fn detects_bias() {
+    // The same comparison must reject an image 3 % too bright or too dark.
+    let film = render(&asset("cornell-box.gltf"), &settings(64, 8, 2), SPP, None);
+    let (mean, var) = film_stats(&film);
+    let (reference, stderr) = reference("cbox_d8");
+    for scale in [0.97, 1.03] {
+        let biased: Vec<Vec3> = mean.iter().map(|m| *m * scale).collect();
+        let a = agreement(&biased, &var, &reference, &squares(&stderr));
+        let passes =
+            a.mean_rel.abs().max_element() < 0.02 && a.mean_z.abs().max_element() < 5.0 && a.outliers < MAX_OUTLIERS;
+        assert!(!passes, "a {scale}× image passed: {a:?}");
+    }
+}
+
+#[test]
+fn gpu_and_cpu_agree_in_distribution() {
+    // Different seeds: two independent estimates of the same image.
+    let Some(ctx) = gpu("gpu_and_cpu_agree_in_distribution") else { return };
+    let g = render(&asset("cornell-box.gltf"), &settings(64, 8, 3), SPP, Some(ctx));
+    let c = render(&asset("cornell-box.gltf"), &settings(64, 8, 33), SPP, None);
+    let (gm, gv) = film_stats(&g);
+    let (cm, cv) = film_stats(&c);
+    assert_agrees("cbox gpu vs cpu", &agreement(&gm, &gv, &cm, &cv));
+}
+
+#[test]
+fn gpu_and_cpu_trace_the_same_paths() {
+    // Same seed: both backends draw the same random numbers, so apart from float rounding
+    // (which can flip a rare path) they compute the same pixels.
+    let Some(ctx) = gpu("gpu_and_cpu_trace_the_same_paths") else { return };
+    let s = settings(32, 8, 9);
+    let g = render(&asset("cornell-box.gltf"), &s, 16, Some(ctx));
+    let c = render(&asset("cornell-box.gltf"), &s, 16, None);
+    let close = (0..g.pixel_count())
+        .filter(|&i| (g.mean(i) - c.mean(i)).abs().max_element() <= 1e-3 * c.mean(i).max_element().max(1e-3))
+        .count();
+    assert!(close as f64 >= 0.98 * g.pixel_count() as f64, "only {close}/{} pixels match", g.pixel_count());
+}
+
+fn furnace(ctx: Option<veach::gpu::GpuContext>) {
+    // Albedo 1 in a constant environment of radiance 1: every pixel is exactly 1.
+    let film = render(&asset("furnace-a100.gltf"), &settings(32, 8, 4), 16, ctx);
+    for i in 0..film.pixel_count() {
+        let m = film.mean(i);
+        assert!((m - Vec3::ONE).abs().max_element() < 1e-5, "pixel {i}: {m}");
+    }
+}
+
+#[test]
+fn white_furnace_cpu() {
+    furnace(None);
+}
+
+#[test]
+fn white_furnace_gpu() {
+    if let Some(ctx) = gpu("white_furnace_gpu") {
+        furnace(Some(ctx));
+    }
+}
+
+#[test]
+fn grey_furnace_matches_reference() {
+    // Albedo 0.8: sphere pixels read 0.8 (one bounce, then the environment), edges mix with 1.
+    let film = render(&asset("furnace-a080.gltf"), &settings(64, 8, 5), 64, None);
+    let (mean, var) = film_stats(&film);
+    let (reference, stderr) = reference("furnace_a080");
+    assert_agrees("furnace 0.8", &agreement(&mean, &var, &reference, &squares(&stderr)));
+    let centre = film.mean(32 * 64 + 32);
+    assert!((centre - Vec3::splat(0.8)).abs().max_element() < 1e-5, "centre {centre}");
+}
+
+fn film_bytes(ctx: Option<veach::gpu::GpuContext>, seed: u32) -> (Vec<u8>, Vec<u8>) {
+    let film = render(&asset("cornell-box.gltf"), &settings(32, 8, seed), 8, ctx);
+    let dir =
+        std::env::temp_dir().join(format!("veach-det-{}-{seed}-{:?}", std::process::id(), std::thread::current().id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let (png, exr) = (dir.join("a.png"), dir.join("a.exr"));
+    veach::output::write(&film, &png, 0.0).expect("png");
+    veach::output::write(&film, &exr, 0.0).expect("exr");
+    let out = (std::fs::read(&png).expect("png"), std::fs::read(&exr).expect("exr"));
+    let _ = std::fs::remove_dir_all(&dir);
+    out
+}
+
+#[test]
+fn same_seed_same_bytes_cpu() {
+    assert_eq!(film_bytes(None, 11), film_bytes(None, 11));
+    assert_ne!(film_bytes(None, 11).1, film_bytes(None, 12).1);
+}
+
+#[test]
+fn same_seed_same_bytes_gpu() {
+    let Some(a) = gpu("same_seed_same_bytes_gpu") else { return };
+    let first = film_bytes(Some(a), 11);
+    let second = film_bytes(gpu("same_seed_same_bytes_gpu"), 11);
+    let other = film_bytes(gpu("same_seed_same_bytes_gpu"), 12);
+    assert_eq!(first, second);
+    assert_ne!(first.1, other.1);
+}
