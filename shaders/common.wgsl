@@ -37,8 +37,12 @@ struct Material {
     metallic: f32,
     emission: vec3<f32>,
     roughness: f32,
-    specular: vec3<f32>,
+    dielectric_f0: vec3<f32>,
     ior: f32,
+    dielectric_f90: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
 }
 
 struct LightEntry {
@@ -68,7 +72,8 @@ struct Params {
     image_height: u32,
     tile_x: u32,
     tile_y: u32,
-    pad: u32,
+    // Probability that light sampling picks the environment (the rest goes to triangles).
+    env_select: f32,
 }
 
 struct Ray {
@@ -86,4 +91,8 @@ fn is_finite_f32(x: f32) -> bool {
 
 fn is_finite_vec3(v: vec3<f32>) -> bool {
     return is_finite_f32(v.x) && is_finite_f32(v.y) && is_finite_f32(v.z);
+}
+
+fn luminance(c: vec3<f32>) -> f32 {
+    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
 }

@@ -28,6 +28,15 @@ fn oct_decode(bits: u32) -> vec3<f32> {
     return normalize(vec3<f32>(x, y, z));
 }
 
+// Is the light sample visible from `origin`? Segments end just off the light's surface.
+fn unoccluded(origin: vec3<f32>, ls: LightSample) -> bool {
+    if (ls.dist == INF) {
+        return !occluded(Ray(origin, ls.wi), INF);
+    }
+    let target_point = offset_ray(ls.point, ls.normal);
+    return !occluded(Ray(origin, target_point - origin), 1.0);
+}
+
 // Radiance arriving along a camera ray. Path depth counts segments (Mitsuba's max_depth).
 fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
     let strategy = params.strategy;
@@ -41,7 +50,15 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
         let hit = intersect_closest(ray);
         depth += 1u;
         if (hit.tri == NO_HIT) {
-            radiance += beta * params.environment;
+            var w = 1.0;
+            if (depth > 1u && !prev_delta && params.env_select > 0.0) {
+                if (strategy == STRATEGY_LIGHT) {
+                    w = 0.0;
+                } else if (strategy != STRATEGY_BSDF) {
+                    w = mis_weight(strategy, prev_pdf, environment_pdf());
+                }
+            }
+            radiance += beta * params.environment * w;
             break;
         }
         let tri = triangles[hit.tri];
@@ -75,16 +92,14 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
         let origin = offset_ray(point, ng);
 
         // Next-event estimation: one light sample.
-        if (strategy != STRATEGY_BSDF && params.light_count > 0u) {
+        if (strategy != STRATEGY_BSDF && (params.light_count > 0u || params.env_select > 0.0)) {
             let u_light = vec3<f32>(rng_next(rng), rng_next2(rng));
             let ls = sample_light(point, u_light);
             if (ls.pdf > 0.0) {
-                let target_point = offset_ray(ls.point, ls.normal);
-                let wi = normalize(ls.point - point);
+                let wi = ls.wi;
                 let wi_local = to_local(frame, wi);
                 let f = bsdf_eval(m, wo, wi_local);
-                if (dot(wi, ng) > 0.0 && max_component(f) > 0.0 &&
-                    !occluded(Ray(origin, target_point - origin), 1.0)) {
+                if (dot(wi, ng) > 0.0 && max_component(f) > 0.0 && unoccluded(origin, ls)) {
                     var w = 1.0;
                     if (strategy != STRATEGY_LIGHT) {
                         w = mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, wi_local));

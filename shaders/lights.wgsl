@@ -1,10 +1,16 @@
-// Area lights: emissive triangles chosen in proportion to power (area × luminance) by an
-// alias_slot table, a point sampled uniformly on the triangle, its area pdf turned into a
-// solid-angle pdf r² / (|cos θ_light| · area). Front faces emit. Twin: src/cpu/lights.rs.
+// Lights: emissive triangles and the environment. Light sampling picks the environment with
+// probability params.env_select, else a triangle in proportion to its power (area ×
+// luminance) through an alias table, then a point uniformly on it; the area pdf becomes a
+// solid-angle pdf r² / (|cos θ_light| · area). Triangles emit from their front face.
+// Twin: src/cpu/lights.rs.
 #include "bindings.wgsl"
 #include "sampling.wgsl"
 
 struct LightSample {
+    // Unit direction from the shading point to the light.
+    wi: vec3<f32>,
+    // Distance to the light point; INF for the environment.
+    dist: f32,
     point: vec3<f32>,
     // Unit geometric normal of the light (its emitting side).
     normal: vec3<f32>,
@@ -14,8 +20,13 @@ struct LightSample {
 }
 
 fn sample_light(ref_point: vec3<f32>, u: vec3<f32>) -> LightSample {
+    let env_select = params.env_select;
+    if (u.x < env_select) {
+        let wi = sample_uniform_sphere(u.yz);
+        return LightSample(wi, INF, ref_point, -wi, params.environment, environment_pdf());
+    }
     let n = params.light_count;
-    let scaled = u.x * f32(n);
+    let scaled = (u.x - env_select) / (1.0 - env_select) * f32(n);
     let slot = min(u32(scaled), n - 1u);
     var entry = lights[slot];
     if (scaled - f32(slot) >= entry.prob) {
@@ -27,15 +38,22 @@ fn sample_light(ref_point: vec3<f32>, u: vec3<f32>) -> LightSample {
     let normal = normalize(cross(tri.e1, tri.e2));
     let to_light = point - ref_point;
     let dist2 = dot(to_light, to_light);
-    let cos_light = -dot(to_light, normal) * inverseSqrt(dist2);
+    let dist = sqrt(dist2);
+    let wi = to_light / dist;
+    let cos_light = -dot(wi, normal);
     let radiance = materials[tri.material].emission;
     if (cos_light <= 0.0 || dist2 <= 0.0) {
-        return LightSample(point, normal, radiance, 0.0);
+        return LightSample(wi, dist, point, normal, radiance, 0.0);
     }
-    return LightSample(point, normal, radiance, light_pdf(tri, dist2, cos_light));
+    return LightSample(wi, dist, point, normal, radiance, light_pdf(tri, dist2, cos_light));
 }
 
 // Solid-angle density of sampling `tri` from a point at squared distance `dist2`.
 fn light_pdf(tri: Triangle, dist2: f32, cos_light: f32) -> f32 {
-    return tri.light_pdf_area * dist2 / abs(cos_light);
+    return (1.0 - params.env_select) * tri.light_pdf_area * dist2 / abs(cos_light);
+}
+
+// Solid-angle density of sampling a direction towards the (constant) environment.
+fn environment_pdf() -> f32 {
+    return params.env_select * UNIFORM_SPHERE_PDF;
 }

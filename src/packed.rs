@@ -51,9 +51,13 @@ pub struct PackedMaterial {
     pub metallic: f32,
     pub emission: [f32; 3],
     pub roughness: f32,
-    /// specularColor × specularFactor (KHR_materials_specular), the dielectric F0 tint.
-    pub specular: [f32; 3],
+    /// Fresnel reflectance at normal incidence of the dielectric (non-metal) part:
+    /// ((ior − 1)/(ior + 1))² × specularColor, clamped to 1, × specularFactor.
+    pub dielectric_f0: [f32; 3],
     pub ior: f32,
+    /// Grazing reflectance of the dielectric part (= specularFactor).
+    pub dielectric_f90: f32,
+    pub pad: [f32; 3],
 }
 
 /// One entry of the light alias table (Vose): pick entry `i` uniformly, keep it with
@@ -160,9 +164,17 @@ fn pack_material(m: &Material) -> PackedMaterial {
         metallic: m.metallic,
         emission: m.emission.into(),
         roughness: m.roughness,
-        specular: (m.specular_color * m.specular_factor).into(),
+        dielectric_f0: dielectric_f0(m).into(),
         ior: m.ior,
+        dielectric_f90: m.specular_factor,
+        pad: [0.0; 3],
     }
+}
+
+/// The dielectric F0 of glTF's metallic-roughness model with KHR_materials_specular/_ior.
+pub fn dielectric_f0(m: &Material) -> Vec3 {
+    let r = (m.ior - 1.0) / (m.ior + 1.0);
+    (r * r * m.specular_color).min(Vec3::ONE) * m.specular_factor
 }
 
 /// Vose's alias method: O(1) sampling of a discrete distribution, built in f64.

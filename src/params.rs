@@ -26,11 +26,24 @@ pub struct Params {
     pub image_height: u32,
     pub tile_x: u32,
     pub tile_y: u32,
-    pub pad: u32,
+    /// Probability that light sampling picks the environment (the rest goes to triangles).
+    pub env_select: f32,
 }
 
 /// Russian roulette starts once a path has this many segments.
 pub const RR_DEPTH: u32 = 3;
+
+/// The environment is a light when it is not black: all of light sampling when the scene has
+/// no emissive triangles, else half of it.
+pub fn env_select_probability(environment: Vec3, light_count: u32) -> f32 {
+    if environment.max_element() <= 0.0 {
+        0.0
+    } else if light_count == 0 {
+        1.0
+    } else {
+        0.5
+    }
+}
 
 impl Params {
     #[allow(clippy::too_many_arguments)]
@@ -65,7 +78,7 @@ impl Params {
             image_height: h,
             tile_x: tile.x,
             tile_y: tile.y,
-            pad: 0,
+            env_select: env_select_probability(environment, light_count),
         }
     }
 }

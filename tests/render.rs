@@ -81,36 +81,41 @@ fn gpu_and_cpu_trace_the_same_paths() {
     assert!(close as f64 >= 0.98 * g.pixel_count() as f64, "only {close}/{} pixels match", g.pixel_count());
 }
 
-fn furnace(ctx: Option<veach::gpu::GpuContext>) {
-    // Albedo 1 in a constant environment of radiance 1: every pixel is exactly 1.
-    let film = render(&asset("furnace-a100.gltf"), &settings(32, 8, 4), 16, ctx);
-    for i in 0..film.pixel_count() {
-        let m = film.mean(i);
-        assert!((m - Vec3::ONE).abs().max_element() < 1e-5, "pixel {i}: {m}");
-    }
+fn furnace(ctx: Option<veach::gpu::GpuContext>, what: &str) {
+    // Albedo 1 in a constant environment of radiance 1 (sampled as a light and combined with
+    // BSDF samples by MIS): every pixel is 1 in expectation; the image mean within 0.5 %.
+    let film = render(&asset("furnace-a100.gltf"), &settings(64, 8, 4), 64, ctx);
+    let (mean, var) = film_stats(&film);
+    let ones = vec![Vec3::ONE; mean.len()];
+    let a = agreement(&mean, &var, &ones, &vec![Vec3::ZERO; mean.len()]);
+    assert_agrees(what, &a);
+    assert!(a.mean_rel.abs().max_element() < 0.005, "{what}: {a:?}");
 }
 
 #[test]
 fn white_furnace_cpu() {
-    furnace(None);
+    furnace(None, "white furnace cpu");
 }
 
 #[test]
 fn white_furnace_gpu() {
     if let Some(ctx) = gpu("white_furnace_gpu") {
-        furnace(Some(ctx));
+        furnace(Some(ctx), "white furnace gpu");
     }
 }
 
 #[test]
 fn grey_furnace_matches_reference() {
-    // Albedo 0.8: sphere pixels read 0.8 (one bounce, then the environment), edges mix with 1.
+    // Albedo 0.8: the sphere is convex, so it sees only the environment and its pixels read
+    // 0.8 whatever the depth (≥ 2); the background reads 1; edge pixels mix the two.
     let film = render(&asset("furnace-a080.gltf"), &settings(64, 8, 5), 64, None);
     let (mean, var) = film_stats(&film);
     let (reference, stderr) = reference("furnace_a080");
     assert_agrees("furnace 0.8", &agreement(&mean, &var, &reference, &squares(&stderr)));
-    let centre = film.mean(32 * 64 + 32);
-    assert!((centre - Vec3::splat(0.8)).abs().max_element() < 1e-5, "centre {centre}");
+    let inside: Vec<usize> = (0..mean.len()).filter(|&i| (reference[i].x - 0.8).abs() < 1e-3).collect();
+    assert!(inside.len() > 500, "the sphere covers many pixels");
+    let avg = inside.iter().map(|&i| mean[i].x as f64).sum::<f64>() / inside.len() as f64;
+    assert!((avg - 0.8).abs() < 0.004, "sphere pixels average {avg}, expected 0.8");
 }
 
 fn film_bytes(ctx: Option<veach::gpu::GpuContext>, seed: u32) -> (Vec<u8>, Vec<u8>) {

@@ -1,10 +1,10 @@
 //! Twin of `shaders/integrator.wgsl`: the path tracer, sample for sample.
 
 use super::bsdf::{bsdf_eval, bsdf_pdf, bsdf_sample};
-use super::bvh::{NO_HIT, Ray, intersect_closest, occluded, offset_ray};
+use super::bvh::{INF, NO_HIT, Ray, intersect_closest, occluded, offset_ray};
 use super::camera::generate_ray;
 use super::frame::{frame_from_normal, from_local, to_local};
-use super::lights::{light_pdf, sample_light};
+use super::lights::{LightSample, environment_pdf, light_pdf, sample_light};
 use super::mis::mis_weight;
 use super::rng::{rng_init, rng_next, rng_next2};
 use crate::Strategy;
@@ -22,6 +22,14 @@ fn shading_normal(scene: &PackedScene, tri: &PackedTriangle, index: u32, u: f32,
     if len2 > 0.0 { n / len2.sqrt() } else { ng }
 }
 
+fn unoccluded(scene: &PackedScene, origin: Vec3, ls: &LightSample) -> bool {
+    if ls.dist == INF {
+        return !occluded(&scene.nodes, &scene.triangles, &Ray { origin, dir: ls.wi }, INF);
+    }
+    let target = offset_ray(ls.point, ls.normal);
+    !occluded(&scene.nodes, &scene.triangles, &Ray { origin, dir: target - origin }, 1.0)
+}
+
 pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) -> Vec3 {
     let strategy = Strategy::from_u32(params.strategy);
     let (nodes, tris) = (&scene.nodes[..], &scene.triangles[..]);
@@ -35,7 +43,15 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
         let hit = intersect_closest(nodes, tris, &ray);
         depth += 1;
         if hit.tri == NO_HIT {
-            radiance += beta * Vec3::from(params.environment);
+            let mut w = 1.0;
+            if depth > 1 && !prev_delta && params.env_select > 0.0 {
+                match strategy {
+                    Strategy::Light => w = 0.0,
+                    Strategy::Bsdf => {}
+                    _ => w = mis_weight(strategy, prev_pdf, environment_pdf(params)),
+                }
+            }
+            radiance += beta * Vec3::from(params.environment) * w;
             break;
         }
         let tri = &tris[hit.tri as usize];
@@ -52,7 +68,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
                 match strategy {
                     Strategy::Light => w = 0.0,
                     Strategy::Bsdf => {}
-                    _ => w = mis_weight(strategy, prev_pdf, light_pdf(tri, hit.t * hit.t, cos_hit)),
+                    _ => w = mis_weight(strategy, prev_pdf, light_pdf(params, tri, hit.t * hit.t, cos_hit)),
                 }
             }
             radiance += beta * emission * w;
@@ -70,19 +86,15 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
         let wo = to_local(&frame, -ray.dir);
         let origin = offset_ray(point, ng);
 
-        if strategy != Strategy::Bsdf && params.light_count > 0 {
+        if strategy != Strategy::Bsdf && (params.light_count > 0 || params.env_select > 0.0) {
             let u0 = rng_next(rng);
             let u12 = rng_next2(rng);
-            let ls = sample_light(scene, point, Vec3::new(u0, u12.x, u12.y));
+            let ls = sample_light(scene, params, point, Vec3::new(u0, u12.x, u12.y));
             if ls.pdf > 0.0 {
-                let target = offset_ray(ls.point, ls.normal);
-                let wi = (ls.point - point).normalize();
+                let wi = ls.wi;
                 let wi_local = to_local(&frame, wi);
                 let f = bsdf_eval(m, wo, wi_local);
-                if wi.dot(ng) > 0.0
-                    && f.max_element() > 0.0
-                    && !occluded(nodes, tris, &Ray { origin, dir: target - origin }, 1.0)
-                {
+                if wi.dot(ng) > 0.0 && f.max_element() > 0.0 && unoccluded(scene, origin, &ls) {
                     let w = if strategy == Strategy::Light {
                         1.0
                     } else {

@@ -9,6 +9,7 @@ pub mod camera;
 pub mod frame;
 pub mod integrator;
 pub mod lights;
+pub mod microfacet;
 pub mod mis;
 pub mod rng;
 pub mod sampling;

@@ -11,6 +11,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("mis.wgsl", include_str!("../../shaders/mis.wgsl")),
     ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
     ("camera.wgsl", include_str!("../../shaders/camera.wgsl")),
+    ("microfacet.wgsl", include_str!("../../shaders/microfacet.wgsl")),
     ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
     ("integrator.wgsl", include_str!("../../shaders/integrator.wgsl")),

@@ -1,0 +1,46 @@
+//! Twin of `shaders/microfacet.wgsl`: GGX with height-correlated Smith masking and VNDF sampling.
+
+use super::bvh::INF;
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+pub fn ggx_d(h: Vec3, alpha: f32) -> f32 {
+    let a2 = alpha * alpha;
+    let d = h.z * h.z * (a2 - 1.0) + 1.0;
+    a2 / (PI * d * d)
+}
+
+pub fn ggx_lambda(w: Vec3, alpha: f32) -> f32 {
+    let c2 = w.z * w.z;
+    if c2 <= 0.0 {
+        return INF;
+    }
+    let t2 = (1.0 - c2).max(0.0) / c2;
+    0.5 * ((1.0 + alpha * alpha * t2).sqrt() - 1.0)
+}
+
+pub fn ggx_g1(w: Vec3, alpha: f32) -> f32 {
+    1.0 / (1.0 + ggx_lambda(w, alpha))
+}
+
+pub fn ggx_g2(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
+    1.0 / (1.0 + ggx_lambda(wo, alpha) + ggx_lambda(wi, alpha))
+}
+
+pub fn ggx_sample_vndf(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
+    let vh = Vec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
+    let len2 = vh.x * vh.x + vh.y * vh.y;
+    let t1 = if len2 > 0.0 { Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt() } else { Vec3::X };
+    let t2 = vh.cross(t1);
+    let r = u.x.sqrt();
+    let phi = 2.0 * PI * u.y;
+    let p1 = r * phi.cos();
+    let s = 0.5 * (1.0 + vh.z);
+    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+    let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
+    Vec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(1e-7)).normalize()
+}
+
+pub fn ggx_reflection_pdf(wo: Vec3, h: Vec3, alpha: f32) -> f32 {
+    ggx_g1(wo, alpha) * ggx_d(h, alpha) / (4.0 * wo.z)
+}
