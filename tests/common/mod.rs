@@ -69,7 +69,9 @@ pub struct Agreement {
 }
 
 /// Compares `a` (with per-pixel variance of its mean `var_a`) with `b` (variance `var_b`).
-/// Pixels whose combined variance is zero must agree to 1e-4 relative, else they count as outliers.
+/// Both sides are f32 sums of many samples, so a relative rounding error of 1e-5 is allowed
+/// on top of the statistical one (it matters only for noise-free pixels, e.g. lights seen
+/// directly).
 pub fn agreement(a: &[Vec3], var_a: &[Vec3], b: &[Vec3], var_b: &[Vec3]) -> Agreement {
     let n = a.len() as f64;
     let (mut sum_a, mut sum_b, mut var_sum) = ([0f64; 3], [0f64; 3], [0f64; 3]);
@@ -81,11 +83,8 @@ pub fn agreement(a: &[Vec3], var_a: &[Vec3], b: &[Vec3], var_b: &[Vec3]) -> Agre
             sum_a[c] += x;
             sum_b[c] += y;
             var_sum[c] += v;
-            let bad = if v > 0.0 {
-                ((x - y) / v.sqrt()).abs() > 4.0
-            } else {
-                (x - y).abs() > 1e-4 * x.abs().max(y.abs()).max(1e-3)
-            };
+            let rounding = 1e-5 * x.abs().max(y.abs()) + 1e-7;
+            let bad = (x - y).abs() > 4.0 * v.sqrt() + rounding;
             outliers += bad as usize;
         }
     }
@@ -96,6 +95,25 @@ pub fn agreement(a: &[Vec3], var_a: &[Vec3], b: &[Vec3], var_b: &[Vec3]) -> Agre
         mean_z: Vec3::new(z(0), z(1), z(2)),
         outliers: outliers as f64 / (3.0 * n),
     }
+}
+
+/// Pools square blocks of `block`×`block` pixels (means averaged, variances of the mean
+/// combined), for estimators whose per-pixel sample variance is too heavy-tailed to trust at
+/// low sample counts.
+pub fn pool(values: &[Vec3], variances: &[Vec3], width: usize, block: usize) -> (Vec<Vec3>, Vec<Vec3>) {
+    let height = values.len() / width;
+    let (bw, bh) = (width / block, height / block);
+    let mut m = vec![Vec3::ZERO; bw * bh];
+    let mut v = vec![Vec3::ZERO; bw * bh];
+    let k = (block * block) as f32;
+    for y in 0..bh * block {
+        for x in 0..bw * block {
+            let b = (y / block) * bw + x / block;
+            m[b] += values[y * width + x] / k;
+            v[b] += variances[y * width + x] / (k * k);
+        }
+    }
+    (m, v)
 }
 
 pub fn film_stats(film: &Film) -> (Vec<Vec3>, Vec<Vec3>) {

@@ -1,0 +1,194 @@
+//! BSDF sampling is right: `sample` draws directions with the density `pdf` says (chi-square
+//! over the sphere, as pbrt and Mitsuba test theirs), and `eval·cos/pdf` averages to the
+//! albedo a quadrature of `eval·cos` gives.
+
+use glam::Vec3;
+use std::f32::consts::PI;
+use veach::cpu::bsdf::{bsdf_eval, bsdf_pdf, bsdf_sample};
+use veach::packed::{PackedMaterial, dielectric_f0};
+use veach::scene::Material;
+
+struct Lcg(u64);
+impl Lcg {
+    fn f(&mut self) -> f32 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+fn material(base: f32, metallic: f32, roughness: f32, specular: f32) -> PackedMaterial {
+    let m = Material {
+        base_color: Vec3::new(base, base * 0.8, base * 0.6),
+        metallic,
+        roughness,
+        specular_factor: specular,
+        ..Material::default()
+    };
+    PackedMaterial {
+        base_color: m.base_color.into(),
+        metallic,
+        emission: [0.0; 3],
+        roughness,
+        dielectric_f0: dielectric_f0(&m).into(),
+        ior: m.ior,
+        dielectric_f90: specular,
+        pad: [0.0; 3],
+    }
+}
+
+fn cases() -> Vec<(String, PackedMaterial)> {
+    let mut v = vec![("lambert".to_string(), material(0.8, 0.0, 1.0, 0.0))];
+    for r in [0.3, 0.5, 0.8] {
+        v.push((format!("metal r={r}"), material(0.9, 1.0, r, 1.0)));
+        v.push((format!("plastic r={r}"), material(0.5, 0.0, r, 1.0)));
+        v.push((format!("half-metal r={r}"), material(0.7, 0.5, r, 0.5)));
+    }
+    v
+}
+
+fn direction(cos_theta: f32, phi: f32) -> Vec3 {
+    let s = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    Vec3::new(s * phi.cos(), s * phi.sin(), cos_theta)
+}
+
+/// Upper tail of the chi-square distribution (Wilson–Hilferty normal approximation).
+fn chi2_p_value(chi2: f64, dof: f64) -> f64 {
+    let z = ((chi2 / dof).powf(1.0 / 3.0) - (1.0 - 2.0 / (9.0 * dof))) / (2.0 / (9.0 * dof)).sqrt();
+    0.5 * erfc(z / std::f64::consts::SQRT_2)
+}
+
+fn erfc(x: f64) -> f64 {
+    // Numerical Recipes' erfc, relative error < 1.2e-7.
+    let z = x.abs();
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let r = t
+        * (-z * z - 1.26551223
+            + t * (1.00002368
+                + t * (0.37409196
+                    + t * (0.09678418
+                        + t * (-0.18628806
+                            + t * (0.27886807
+                                + t * (-1.13520398 + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+            .exp();
+    if x >= 0.0 { r } else { 2.0 - r }
+}
+
+#[test]
+fn bsdf_sample_matches_pdf_chi_square() {
+    const THETA: usize = 20;
+    const PHI: usize = 40;
+    const N: usize = 400_000;
+    // Sub-cells per bin side: the midpoint rule must resolve the α = 0.09 lobe (12 is too coarse).
+    const SUB: usize = 32;
+    let mut rng = Lcg(1);
+    let mut tests = 0;
+    for (name, m) in cases() {
+        for theta_o in [10f32, 45.0, 80.0] {
+            let t = theta_o.to_radians();
+            let wo = Vec3::new(t.sin(), 0.0, t.cos());
+            // Observed: histogram over (cos θ, φ) ∈ [−1, 1] × [0, 2π), plus failed samples.
+            let mut observed = vec![0f64; THETA * PHI + 1];
+            for _ in 0..N {
+                let u = Vec3::new(rng.f(), rng.f(), rng.f());
+                let s = bsdf_sample(&m, wo, u);
+                if s.pdf <= 0.0 {
+                    observed[THETA * PHI] += 1.0;
+                    continue;
+                }
+                assert!(!s.delta, "{name}: no Dirac lobe here");
+                let pdf = bsdf_pdf(&m, wo, s.wi);
+                assert!((pdf - s.pdf).abs() <= 1e-3 * pdf, "{name}: sample pdf {} vs pdf() {pdf}", s.pdf);
+                let i = (((s.wi.z + 1.0) * 0.5 * THETA as f32) as usize).min(THETA - 1);
+                let mut phi = s.wi.y.atan2(s.wi.x);
+                if phi < 0.0 {
+                    phi += 2.0 * PI;
+                }
+                let j = ((phi / (2.0 * PI) * PHI as f32) as usize).min(PHI - 1);
+                observed[i * PHI + j] += 1.0;
+            }
+            // Expected: N × ∫ pdf dω over each bin (dω = dcosθ dφ), by a midpoint rule.
+            let mut expected = vec![0f64; THETA * PHI + 1];
+            let (dc, dp) = (2.0 / (THETA * SUB) as f64, 2.0 * std::f64::consts::PI / (PHI * SUB) as f64);
+            let mut total = 0.0;
+            for i in 0..THETA * SUB {
+                let c = -1.0 + (i as f64 + 0.5) * dc;
+                for j in 0..PHI * SUB {
+                    let p = (j as f64 + 0.5) * dp;
+                    let pdf = bsdf_pdf(&m, wo, direction(c as f32, p as f32)) as f64 * dc * dp;
+                    expected[(i / SUB) * PHI + j / SUB] += pdf * N as f64;
+                    total += pdf;
+                }
+            }
+            assert!(total < 1.0 + 2e-3, "{name} θo={theta_o}: pdf integrates to {total}");
+            expected[THETA * PHI] = (1.0 - total).max(0.0) * N as f64;
+            // Pool bins expecting fewer than 5 samples, then Pearson's statistic.
+            let (mut chi2, mut dof, mut pool_o, mut pool_e) = (0.0, 0.0, 0.0, 0.0);
+            for (o, e) in observed.iter().zip(&expected) {
+                if *e < 5.0 {
+                    pool_o += o;
+                    pool_e += e;
+                } else {
+                    chi2 += (o - e) * (o - e) / e;
+                    dof += 1.0;
+                }
+            }
+            if pool_e >= 5.0 {
+                chi2 += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
+                dof += 1.0;
+            } else {
+                assert!(pool_o <= 10.0 + pool_e * 5.0, "{name}: {pool_o} samples where pdf ≈ 0");
+            }
+            dof -= 1.0;
+            let p = chi2_p_value(chi2, dof);
+            tests += 1;
+            // 1 % significance, Šidák-corrected over the 30 cases.
+            assert!(
+                p > 1.0 - 0.99f64.powf(1.0 / 30.0),
+                "{name} θo={theta_o}: chi² = {chi2:.1}, dof {dof}, p = {p:.2e}"
+            );
+        }
+    }
+    assert_eq!(tests, 30);
+}
+
+#[test]
+fn sampled_albedo_equals_quadrature() {
+    let mut rng = Lcg(2);
+    for (name, m) in cases() {
+        for theta_o in [10f32, 45.0, 80.0] {
+            let t = theta_o.to_radians();
+            let wo = Vec3::new(t.sin(), 0.0, t.cos());
+            // Quadrature of f·cos over the hemisphere in (cos θ, φ).
+            let (nc, np) = (800usize, 400usize);
+            let mut quad = Vec3::ZERO.as_dvec3();
+            for i in 0..nc {
+                let c = (i as f32 + 0.5) / nc as f32;
+                for j in 0..np {
+                    let p = (j as f32 + 0.5) / np as f32 * 2.0 * PI;
+                    let wi = direction(c, p);
+                    quad += (bsdf_eval(&m, wo, wi) * c).as_dvec3();
+                }
+            }
+            quad *= 2.0 * std::f64::consts::PI / (nc * np) as f64;
+            // Monte Carlo with the BSDF's own sampling.
+            let n = 200_000;
+            let mut mc = Vec3::ZERO.as_dvec3();
+            let mut mc2 = Vec3::ZERO.as_dvec3();
+            for _ in 0..n {
+                let s = bsdf_sample(&m, wo, Vec3::new(rng.f(), rng.f(), rng.f()));
+                mc += s.weight.as_dvec3();
+                mc2 += (s.weight * s.weight).as_dvec3();
+            }
+            mc /= n as f64;
+            let stderr = ((mc2 / n as f64 - mc * mc) / n as f64).max(glam::DVec3::ZERO).sqrt();
+            for c in 0..3 {
+                let tol = 4.0 * stderr[c] + 2e-3 * quad[c];
+                assert!(
+                    (mc[c] - quad[c]).abs() <= tol,
+                    "{name} θo={theta_o}: sampled albedo {mc} vs quadrature {quad} (stderr {stderr})"
+                );
+            }
+            assert!(quad.max_element() <= 1.0 + 1e-3, "{name}: albedo {quad} above 1");
+        }
+    }
+}
