@@ -8,6 +8,7 @@ pub mod accel;
 pub mod cpu;
 pub mod film;
 pub mod gpu;
+pub mod label;
 pub mod output;
 pub mod packed;
 pub mod params;

@@ -22,8 +22,41 @@ struct Cli {
 enum Command {
     /// Render a glTF 2.0 scene (.gltf/.glb) to a PNG (tone-mapped) or EXR (linear).
     Render(RenderArgs),
+    /// Render the seed's four direct-lighting estimators at equal spp, side by side with labels.
+    Strategies(StrategiesArgs),
     /// List the Vulkan adapters and their limits.
     Info,
+}
+
+#[derive(clap::Args)]
+struct StrategiesArgs {
+    /// The scene, a .gltf or .glb file.
+    scene: PathBuf,
+    /// Output contact sheet (.png).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Samples per pixel of each estimator.
+    #[arg(long, default_value_t = 16)]
+    spp: u32,
+    /// Width of each panel.
+    #[arg(long, default_value_t = 256)]
+    width: u32,
+    /// Height of each panel.
+    #[arg(long, default_value_t = 256)]
+    height: u32,
+    /// Path depth in segments (2 = direct lighting only, the seed's setting).
+    #[arg(long, default_value_t = 2)]
+    max_depth: u32,
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    exposure: f32,
+    #[arg(long, value_enum)]
+    backend: Option<Backend>,
+    #[arg(long)]
+    camera: Option<String>,
+    #[arg(long, value_parser = parse_rgb)]
+    env_color: Option<Vec3>,
 }
 
 #[derive(clap::Args)]
@@ -83,6 +116,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render(&args),
+        Command::Strategies(args) => strategies(&args),
         Command::Info => info(),
     };
     match result {
@@ -162,17 +196,7 @@ fn render(args: &RenderArgs) -> Result<(), Error> {
         environment: args.env_color,
         tile: None,
     };
-    let mut renderer = match args.backend {
-        Some(b) => Renderer::new(packed, &camera, &settings, b)?,
-        None => match veach::gpu::GpuContext::new() {
-            Ok(ctx) => Renderer::with_gpu(packed, &camera, &settings, Backend::Gpu, Some(ctx))?,
-            Err(Error::NoAdapter(msg)) => {
-                eprintln!("veach: warning: {msg}; rendering on the CPU backend");
-                Renderer::new(packed, &camera, &settings, Backend::Cpu)?
-            }
-            Err(e) => return Err(e),
-        },
-    };
+    let mut renderer = open_renderer(packed, &camera, &settings, args.backend)?;
 
     let bar = indicatif::ProgressBar::new(args.spp as u64);
     bar.set_style(
@@ -236,6 +260,77 @@ fn render(args: &RenderArgs) -> Result<(), Error> {
         });
         write_atomic(path, serde_json::to_string_pretty(&stats).unwrap_or_default().as_bytes())?;
     }
+    Ok(())
+}
+
+/// A renderer on the requested backend; with none requested, the GPU, or the CPU with a
+/// one-line warning when there is no Vulkan adapter.
+fn open_renderer(
+    packed: veach::packed::PackedScene,
+    camera: &veach::scene::Camera,
+    settings: &Settings,
+    backend: Option<Backend>,
+) -> Result<Renderer, Error> {
+    match backend {
+        Some(b) => Renderer::new(packed, camera, settings, b),
+        None => match veach::gpu::GpuContext::new() {
+            Ok(ctx) => Renderer::with_gpu(packed, camera, settings, Backend::Gpu, Some(ctx)),
+            Err(Error::NoAdapter(msg)) => {
+                eprintln!("veach: warning: {msg}; rendering on the CPU backend");
+                Renderer::new(packed, camera, settings, Backend::Cpu)
+            }
+            Err(e) => Err(e),
+        },
+    }
+}
+
+fn strategies(args: &StrategiesArgs) -> Result<(), Error> {
+    if veach::output::check_output(&args.output)? != veach::output::Format::Png {
+        return Err(Error::Input(format!("{}: the contact sheet is a .png", args.output.display())));
+    }
+    if args.spp == 0 {
+        return Err(Error::Input("--spp must be at least 1".into()));
+    }
+    let (scene, camera) = veach::load(&args.scene, args.camera.as_deref())?;
+    let packed = veach::packed::PackedScene::new(&scene);
+    let (w, h) = (args.width, args.height);
+    let bar = 14 * 3;
+    let mut sheet = image::RgbImage::new(4 * w, h + bar);
+    let mut backend = args.backend;
+    for (k, strategy) in
+        [Strategy::Bsdf, Strategy::Light, Strategy::MisBalance, Strategy::MisPower].into_iter().enumerate()
+    {
+        let settings = Settings {
+            width: w,
+            height: h,
+            max_depth: args.max_depth,
+            seed: args.seed,
+            strategy,
+            camera: args.camera.clone(),
+            environment: args.env_color,
+            tile: None,
+        };
+        let mut renderer = open_renderer(packed.clone(), &camera, &settings, backend)?;
+        backend = Some(renderer.backend());
+        let t = Instant::now();
+        renderer.render_samples(0, args.spp)?;
+        let film = renderer.film()?;
+        eprintln!("veach: {strategy:?}: {} spp in {:.2} s", args.spp, t.elapsed().as_secs_f64());
+        let panel = veach::output::tonemap(&film, args.exposure);
+        image::imageops::replace(&mut sheet, &panel, (k as u32 * w) as i64, bar as i64);
+        let name = match strategy {
+            Strategy::Bsdf => "BSDF",
+            Strategy::Light => "LIGHT",
+            Strategy::MisBalance => "MIS BALANCE",
+            Strategy::MisPower => "MIS POWER",
+        };
+        let scale = if veach::label::text_width(name, 2) + 8 <= w { 2 } else { 1 };
+        veach::label::draw_text(&mut sheet, k as u32 * w + 6, 6, name, scale, [255, 255, 255]);
+        let sub = format!("{} SPP", args.spp);
+        veach::label::draw_text(&mut sheet, k as u32 * w + 6, 6 + 8 * scale + 4, &sub, 1, [180, 180, 180]);
+    }
+    veach::output::write_png(&sheet, &args.output)?;
+    eprintln!("veach: wrote {}", args.output.display());
     Ok(())
 }
 

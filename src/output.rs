@@ -46,28 +46,38 @@ pub fn to_srgb8(linear: f32, exposure: f32) -> u8 {
     (s * 255.0 + 0.5) as u8
 }
 
+/// The film's mean, exposed, clamped and sRGB-encoded.
+pub fn tonemap(film: &Film, exposure: f32) -> image::RgbImage {
+    let mut img = image::RgbImage::new(film.width, film.height);
+    for (i, px) in img.pixels_mut().enumerate() {
+        let m = film.mean(i);
+        *px = image::Rgb([to_srgb8(m.x, exposure), to_srgb8(m.y, exposure), to_srgb8(m.z, exposure)]);
+    }
+    img
+}
+
 pub fn write(film: &Film, path: &Path, exposure: f32) -> Result<(), Error> {
-    let format = check_output(path)?;
-    let tmp = temp_path(path);
-    let io = |e: String| Error::Input(format!("{}: cannot write output: {e}", path.display()));
-    let result = match format {
-        Format::Png => {
-            let mut img = image::RgbImage::new(film.width, film.height);
-            for (i, px) in img.pixels_mut().enumerate() {
-                let m = film.mean(i);
-                *px = image::Rgb([to_srgb8(m.x, exposure), to_srgb8(m.y, exposure), to_srgb8(m.z, exposure)]);
-            }
-            img.save_with_format(&tmp, image::ImageFormat::Png)
-        }
+    match check_output(path)? {
+        Format::Png => write_png(&tonemap(film, exposure), path),
         Format::Exr => {
             let mut img = image::Rgb32FImage::new(film.width, film.height);
             for (i, px) in img.pixels_mut().enumerate() {
                 let m = film.mean(i);
                 *px = image::Rgb([m.x, m.y, m.z]);
             }
-            img.save_with_format(&tmp, image::ImageFormat::OpenExr)
+            save_atomic(path, |tmp| img.save_with_format(tmp, image::ImageFormat::OpenExr))
         }
-    };
+    }
+}
+
+pub fn write_png(img: &image::RgbImage, path: &Path) -> Result<(), Error> {
+    save_atomic(path, |tmp| img.save_with_format(tmp, image::ImageFormat::Png))
+}
+
+fn save_atomic(path: &Path, save: impl FnOnce(&Path) -> image::ImageResult<()>) -> Result<(), Error> {
+    let tmp = temp_path(path);
+    let io = |e: String| Error::Input(format!("{}: cannot write output: {e}", path.display()));
+    let result = save(&tmp);
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
         return Err(io(e.to_string()));

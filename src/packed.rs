@@ -72,6 +72,7 @@ pub struct LightEntry {
     pub pmf: f32,
 }
 
+#[derive(Clone)]
 pub struct PackedScene {
     pub nodes: Vec<BvhNode>,
     pub triangles: Vec<PackedTriangle>,

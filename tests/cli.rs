@@ -117,6 +117,41 @@ fn renders_png_and_exr_with_stats() {
 }
 
 #[test]
+fn strategies_sheet_has_four_labelled_panels() {
+    let d = temp_dir("sheet");
+    let out = d.join("sheet.png");
+    let scene = common::asset("veach-mis.gltf");
+    let r = veach(
+        &[
+            "strategies",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--spp",
+            "2",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--backend",
+            "cpu",
+        ],
+        &[],
+    );
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let img = image::open(&out).expect("sheet").to_rgb8();
+    assert_eq!(img.width(), 4 * 32);
+    assert!(img.height() > 24, "a label bar above the panels");
+    // Each panel's label is drawn in white in the bar.
+    for k in 0..4 {
+        let white =
+            (0..img.height() - 24).any(|y| (k * 32..k * 32 + 32).any(|x| img.get_pixel(x, y).0 == [255, 255, 255]));
+        assert!(white, "panel {k} has a label");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
 fn without_a_vulkan_driver_falls_back_to_cpu_or_says_how_to_get_one() {
     let d = temp_dir("nogpu");
     let cbox = common::asset("cornell-box.gltf");
