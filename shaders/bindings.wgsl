@@ -7,5 +7,7 @@
 @group(0) @binding(3) var<storage, read> normals: array<Normals>;
 @group(0) @binding(4) var<storage, read> materials: array<Material>;
 @group(0) @binding(5) var<storage, read> lights: array<LightEntry>;
+// Environment map texels (rgb, row CDF), then the marginal CDF of the rows (x).
+@group(0) @binding(7) var<storage, read> env_texels: array<vec4<f32>>;
 // Two rows per pixel: (Σ L, sample count) and (Σ L², dropped non-finite samples).
 @group(0) @binding(6) var<storage, read_write> film: array<vec4<f32>>;

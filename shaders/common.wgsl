@@ -74,6 +74,11 @@ struct Params {
     tile_y: u32,
     // Probability that light sampling picks the environment (the rest goes to triangles).
     env_select: f32,
+    // Environment map size (0 × 0: the environment is the constant `environment`).
+    env_width: u32,
+    env_height: u32,
+    env_total: f32,
+    pad: u32,
 }
 
 struct Ray {

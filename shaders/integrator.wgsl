@@ -55,10 +55,10 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
                 if (strategy == STRATEGY_LIGHT) {
                     w = 0.0;
                 } else if (strategy != STRATEGY_BSDF) {
-                    w = mis_weight(strategy, prev_pdf, environment_pdf());
+                    w = mis_weight(strategy, prev_pdf, environment_pdf(ray.dir));
                 }
             }
-            radiance += beta * params.environment * w;
+            radiance += beta * environment_radiance(ray.dir) * w;
             break;
         }
         let tri = triangles[hit.tri];

@@ -5,6 +5,7 @@
 // Twin: src/cpu/lights.rs.
 #include "bindings.wgsl"
 #include "sampling.wgsl"
+#include "environment.wgsl"
 
 struct LightSample {
     // Unit direction from the shading point to the light.
@@ -22,8 +23,8 @@ struct LightSample {
 fn sample_light(ref_point: vec3<f32>, u: vec3<f32>) -> LightSample {
     let env_select = params.env_select;
     if (u.x < env_select) {
-        let wi = sample_uniform_sphere(u.yz);
-        return LightSample(wi, INF, ref_point, -wi, params.environment, environment_pdf());
+        let wi = sample_environment(u.yz);
+        return LightSample(wi, INF, ref_point, -wi, environment_radiance(wi), environment_pdf(wi));
     }
     let n = params.light_count;
     let scaled = (u.x - env_select) / (1.0 - env_select) * f32(n);
@@ -51,9 +52,4 @@ fn sample_light(ref_point: vec3<f32>, u: vec3<f32>) -> LightSample {
 // Solid-angle density of sampling `tri` from a point at squared distance `dist2`.
 fn light_pdf(tri: Triangle, dist2: f32, cos_light: f32) -> f32 {
     return (1.0 - params.env_select) * tri.light_pdf_area * dist2 / abs(cos_light);
-}
-
-// Solid-angle density of sampling a direction towards the (constant) environment.
-fn environment_pdf() -> f32 {
-    return params.env_select * UNIFORM_SPHERE_PDF;
 }

@@ -159,16 +159,8 @@ impl Renderer {
             )));
         }
         let env = settings.environment.unwrap_or(scene.environment);
-        let params = Params::new(
-            camera,
-            (w, h),
-            tile,
-            settings.seed,
-            settings.max_depth,
-            settings.strategy,
-            env,
-            scene.lights.len() as u32,
-        );
+        let params =
+            Params::new(camera, (w, h), tile, settings.seed, settings.max_depth, settings.strategy, env, &scene);
         let engine = match backend {
             Backend::Cpu => Engine::Cpu(Film::new(tile.width, tile.height)),
             Backend::Gpu => {

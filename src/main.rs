@@ -57,6 +57,12 @@ struct StrategiesArgs {
     camera: Option<String>,
     #[arg(long, value_parser = parse_rgb)]
     env_color: Option<Vec3>,
+    /// Equirectangular environment map (.hdr or .exr), importance-sampled.
+    #[arg(long)]
+    env: Option<PathBuf>,
+    /// Scales the environment (map or color).
+    #[arg(long, default_value_t = 1.0)]
+    env_strength: f32,
 }
 
 #[derive(clap::Args)]
@@ -96,6 +102,12 @@ struct RenderArgs {
     /// Constant environment radiance R,G,B (default: the scene's extras.environment, else black).
     #[arg(long, value_parser = parse_rgb)]
     env_color: Option<Vec3>,
+    /// Equirectangular environment map (.hdr or .exr), importance-sampled; --env-color tints it.
+    #[arg(long)]
+    env: Option<PathBuf>,
+    /// Scales the environment (map or color).
+    #[arg(long, default_value_t = 1.0)]
+    env_strength: f32,
     /// Write render statistics as JSON.
     #[arg(long)]
     stats_json: Option<PathBuf>,
@@ -176,9 +188,10 @@ fn render(args: &RenderArgs) -> Result<(), Error> {
     if args.spp == 0 {
         return Err(Error::Input("--spp must be at least 1".into()));
     }
-    let (scene, camera) = veach::load(&args.scene, args.camera.as_deref())?;
+    let (mut scene, camera) = veach::load(&args.scene, args.camera.as_deref())?;
+    set_environment(&mut scene, args.env.as_deref(), args.env_color, args.env_strength)?;
     let triangles = scene.triangles.len();
-    if scene.emissive_triangle_count() == 0 && scene.environment == Vec3::ZERO && args.env_color.is_none() {
+    if scene.emissive_triangle_count() == 0 && scene.environment == Vec3::ZERO {
         eprintln!(
             "veach: warning: {}: the scene has no lights and no environment; the image will be black",
             args.scene.display()
@@ -193,7 +206,7 @@ fn render(args: &RenderArgs) -> Result<(), Error> {
         seed: args.seed,
         strategy: args.strategy,
         camera: args.camera.clone(),
-        environment: args.env_color,
+        environment: None,
         tile: None,
     };
     let mut renderer = open_renderer(packed, &camera, &settings, args.backend)?;
@@ -263,6 +276,27 @@ fn render(args: &RenderArgs) -> Result<(), Error> {
     Ok(())
 }
 
+/// The environment from the command line: a map (tinted by the color), a color, or the
+/// scene's own, each scaled by the strength.
+fn set_environment(
+    scene: &mut veach::scene::Scene,
+    map: Option<&Path>,
+    color: Option<Vec3>,
+    strength: f32,
+) -> Result<(), Error> {
+    if !strength.is_finite() || strength < 0.0 {
+        return Err(Error::Input(format!("--env-strength {strength}: expected a finite value ≥ 0")));
+    }
+    if let Some(path) = map {
+        scene.environment_map = Some(veach::scene::EnvironmentMap::load(path)?);
+        scene.environment = color.unwrap_or(Vec3::ONE);
+    } else if let Some(c) = color {
+        scene.environment = c;
+    }
+    scene.environment *= strength;
+    Ok(())
+}
+
 /// A renderer on the requested backend; with none requested, the GPU, or the CPU with a
 /// one-line warning when there is no Vulkan adapter.
 fn open_renderer(
@@ -291,7 +325,8 @@ fn strategies(args: &StrategiesArgs) -> Result<(), Error> {
     if args.spp == 0 {
         return Err(Error::Input("--spp must be at least 1".into()));
     }
-    let (scene, camera) = veach::load(&args.scene, args.camera.as_deref())?;
+    let (mut scene, camera) = veach::load(&args.scene, args.camera.as_deref())?;
+    set_environment(&mut scene, args.env.as_deref(), args.env_color, args.env_strength)?;
     let packed = veach::packed::PackedScene::new(&scene);
     let (w, h) = (args.width, args.height);
     let bar = 14 * 3;
@@ -307,7 +342,7 @@ fn strategies(args: &StrategiesArgs) -> Result<(), Error> {
             seed: args.seed,
             strategy,
             camera: args.camera.clone(),
-            environment: args.env_color,
+            environment: None,
             tile: None,
         };
         let mut renderer = open_renderer(packed.clone(), &camera, &settings, backend)?;

@@ -83,6 +83,14 @@ pub struct PackedScene {
     pub order: Vec<u32>,
     pub bvh_build_seconds: f64,
     pub environment: Vec3,
+    /// Environment map texels (rgb, conditional CDF of the row up to this texel), then one
+    /// row per map row (marginal CDF up to this row, 0, 0, 0). One zeroed element when there
+    /// is no map.
+    pub env: Vec<[f32; 4]>,
+    pub env_width: u32,
+    pub env_height: u32,
+    /// Σ luminance × sin θ over all texels: the normaliser of the sampling pmf.
+    pub env_total: f32,
     /// Scene bounds' diagonal length (scale for ray epsilons where needed).
     pub extent: f32,
 }
@@ -139,6 +147,10 @@ impl PackedScene {
         let mut normals: Vec<PackedNormals> =
             ordered.iter().map(|t| PackedNormals { n: t.normals.map(oct_encode), pad: 0 }).collect();
         normals.resize(triangles.len(), PackedNormals::zeroed());
+        let (env, env_width, env_height, env_total) = match &scene.environment_map {
+            Some(map) => pack_environment(map),
+            None => (vec![[0.0; 4]], 0, 0, 0.0),
+        };
         let bounds = scene.bounds();
         let extent = if bounds.is_empty() { 1.0 } else { bounds.diagonal().length() };
         PackedScene {
@@ -150,9 +162,42 @@ impl PackedScene {
             order: bvh.order,
             bvh_build_seconds: bvh.build_seconds,
             environment: scene.environment,
+            env,
+            env_width,
+            env_height,
+            env_total,
             extent,
         }
     }
+}
+
+/// The environment's texels with the CDFs of the piecewise-constant distribution
+/// ∝ luminance × sin θ (marginal over rows, conditional within each row).
+fn pack_environment(map: &crate::scene::EnvironmentMap) -> (Vec<[f32; 4]>, u32, u32, f32) {
+    let (w, h) = (map.width as usize, map.height as usize);
+    let mut env = Vec::with_capacity(w * h + h);
+    let mut row_sums = Vec::with_capacity(h);
+    for i in 0..h {
+        let sin_theta = (std::f64::consts::PI * (i as f64 + 0.5) / h as f64).sin();
+        let row = &map.texels[i * w..(i + 1) * w];
+        let func: Vec<f64> = row.iter().map(|c| luminance(*c) as f64 * sin_theta).collect();
+        let sum: f64 = func.iter().sum();
+        let mut acc = 0.0;
+        for (j, c) in row.iter().enumerate() {
+            acc += func[j];
+            let cdf = if sum > 0.0 { if j + 1 == w { 1.0 } else { acc / sum } } else { (j + 1) as f64 / w as f64 };
+            env.push([c.x, c.y, c.z, cdf as f32]);
+        }
+        row_sums.push(sum);
+    }
+    let total: f64 = row_sums.iter().sum();
+    let mut acc = 0.0;
+    for (i, s) in row_sums.iter().enumerate() {
+        acc += s;
+        let cdf = if total > 0.0 { if i + 1 == h { 1.0 } else { acc / total } } else { 0.0 };
+        env.push([cdf as f32, 0.0, 0.0, 0.0]);
+    }
+    (env, w as u32, h as u32, total as f32)
 }
 
 pub fn luminance(c: Vec3) -> f32 {

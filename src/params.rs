@@ -28,6 +28,11 @@ pub struct Params {
     pub tile_y: u32,
     /// Probability that light sampling picks the environment (the rest goes to triangles).
     pub env_select: f32,
+    /// Environment map size (0 × 0: the environment is the constant `environment`).
+    pub env_width: u32,
+    pub env_height: u32,
+    pub env_total: f32,
+    pub pad: u32,
 }
 
 /// Russian roulette starts once a path has this many segments.
@@ -35,8 +40,8 @@ pub const RR_DEPTH: u32 = 3;
 
 /// The environment is a light when it is not black: all of light sampling when the scene has
 /// no emissive triangles, else half of it.
-pub fn env_select_probability(environment: Vec3, light_count: u32) -> f32 {
-    if environment.max_element() <= 0.0 {
+pub fn env_select_probability(environment: Vec3, has_map: bool, map_total: f32, light_count: u32) -> f32 {
+    if environment.max_element() <= 0.0 || (has_map && map_total <= 0.0) {
         0.0
     } else if light_count == 0 {
         1.0
@@ -55,8 +60,9 @@ impl Params {
         max_depth: u32,
         strategy: Strategy,
         environment: Vec3,
-        light_count: u32,
+        scene: &crate::packed::PackedScene,
     ) -> Params {
+        let light_count = scene.lights.len() as u32;
         let (w, h) = image;
         let tan_half = (0.5 * camera.yfov).tan();
         let aspect = w as f32 / h as f32;
@@ -78,7 +84,11 @@ impl Params {
             image_height: h,
             tile_x: tile.x,
             tile_y: tile.y,
-            env_select: env_select_probability(environment, light_count),
+            env_select: env_select_probability(environment, scene.env_width > 0, scene.env_total, light_count),
+            env_width: scene.env_width,
+            env_height: scene.env_height,
+            env_total: scene.env_total,
+            pad: 0,
         }
     }
 }

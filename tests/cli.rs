@@ -117,6 +117,55 @@ fn renders_png_and_exr_with_stats() {
 }
 
 #[test]
+fn environment_maps_from_hdr_and_exr() {
+    let d = temp_dir("env");
+    let scene = common::asset("furnace-a080.gltf");
+    let mut sky = image::Rgb32FImage::new(32, 16);
+    for (x, y, p) in sky.enumerate_pixels_mut() {
+        *p = image::Rgb([1.0 + x as f32 / 32.0, 0.5, 2.0 * (y < 8) as u8 as f32]);
+    }
+    for name in ["sky.hdr", "sky.exr"] {
+        let env = d.join(name);
+        sky.save(&env).expect("write map");
+        let out = d.join("a.exr");
+        let r = veach(
+            &[
+                "render",
+                scene.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--env",
+                env.to_str().unwrap(),
+                "--env-strength",
+                "2",
+                "--width",
+                "16",
+                "--height",
+                "16",
+                "--spp",
+                "4",
+                "--backend",
+                "cpu",
+            ],
+            &[],
+        );
+        assert!(r.status.success(), "{name}: {}", String::from_utf8_lossy(&r.stderr));
+        let img = image::open(&out).expect("exr").to_rgb32f();
+        // The corner pixel sees the map directly: 2 × a texel, whose green is 0.5.
+        assert!((img.get_pixel(0, 0)[1] - 1.0).abs() < 1e-4, "{name}: {:?}", img.get_pixel(0, 0));
+    }
+    let bad = d.join("sky.txt");
+    std::fs::write(&bad, b"not an image").unwrap();
+    let out = d.join("b.png");
+    assert_user_error(
+        &veach(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--env", bad.to_str().unwrap()], &[]),
+        "sky.txt",
+    );
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
 fn strategies_sheet_has_four_labelled_panels() {
     let d = temp_dir("sheet");
     let out = d.join("sheet.png");

@@ -59,7 +59,7 @@ fn plate_masks() -> Vec<Vec<usize>> {
         2,
         Strategy::MisPower,
         Vec3::ZERO,
-        0,
+        &packed,
     );
     let _ = s;
     let mut plates = vec![Vec::new(); 4];

@@ -3,8 +3,9 @@
 use super::bsdf::{bsdf_eval, bsdf_pdf, bsdf_sample};
 use super::bvh::{INF, NO_HIT, Ray, intersect_closest, occluded, offset_ray};
 use super::camera::generate_ray;
+use super::environment::{environment_pdf, environment_radiance};
 use super::frame::{frame_from_normal, from_local, to_local};
-use super::lights::{LightSample, environment_pdf, light_pdf, sample_light};
+use super::lights::{LightSample, light_pdf, sample_light};
 use super::mis::mis_weight;
 use super::rng::{rng_init, rng_next, rng_next2};
 use crate::Strategy;
@@ -48,10 +49,10 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
                 match strategy {
                     Strategy::Light => w = 0.0,
                     Strategy::Bsdf => {}
-                    _ => w = mis_weight(strategy, prev_pdf, environment_pdf(params)),
+                    _ => w = mis_weight(strategy, prev_pdf, environment_pdf(scene, params, ray.dir)),
                 }
             }
-            radiance += beta * Vec3::from(params.environment) * w;
+            radiance += beta * environment_radiance(scene, params, ray.dir) * w;
             break;
         }
         let tri = &tris[hit.tri as usize];

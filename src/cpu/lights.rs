@@ -1,7 +1,8 @@
 //! Twin of `shaders/lights.wgsl`.
 
 use super::bvh::INF;
-use super::sampling::{UNIFORM_SPHERE_PDF, sample_uniform_sphere, sample_uniform_triangle};
+use super::environment::{environment_pdf, environment_radiance, sample_environment};
+use super::sampling::sample_uniform_triangle;
 use crate::packed::{PackedScene, PackedTriangle};
 use crate::params::Params;
 use glam::{Vec2, Vec3};
@@ -19,14 +20,14 @@ pub struct LightSample {
 pub fn sample_light(scene: &PackedScene, params: &Params, ref_point: Vec3, u: Vec3) -> LightSample {
     let env_select = params.env_select;
     if u.x < env_select {
-        let wi = sample_uniform_sphere(Vec2::new(u.y, u.z));
+        let wi = sample_environment(scene, params, Vec2::new(u.y, u.z));
         return LightSample {
             wi,
             dist: INF,
             point: ref_point,
             normal: -wi,
-            radiance: params.environment.into(),
-            pdf: environment_pdf(params),
+            radiance: environment_radiance(scene, params, wi),
+            pdf: environment_pdf(scene, params, wi),
         };
     }
     let n = params.light_count;
@@ -55,8 +56,4 @@ pub fn sample_light(scene: &PackedScene, params: &Params, ref_point: Vec3, u: Ve
 
 pub fn light_pdf(params: &Params, tri: &PackedTriangle, dist2: f32, cos_light: f32) -> f32 {
     (1.0 - params.env_select) * tri.light_pdf_area * dist2 / cos_light.abs()
-}
-
-pub fn environment_pdf(params: &Params) -> f32 {
-    params.env_select * UNIFORM_SPHERE_PDF
 }

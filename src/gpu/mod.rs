@@ -135,6 +135,7 @@ impl GpuRenderer {
         let normals = storage("normals", bytemuck::cast_slice(&scene.normals))?;
         let materials = storage("materials", bytemuck::cast_slice(&scene.materials))?;
         let lights = storage("lights", bytemuck::cast_slice(&scene.lights))?;
+        let env = storage("environment", bytemuck::cast_slice(&scene.env))?;
         check_limit("film", film_bytes, limits.max_storage_buffer_binding_size, "max_storage_buffer_binding_size")?;
         let film_buf = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("film"),
@@ -191,6 +192,7 @@ impl GpuRenderer {
                 storage_entry(4, true),
                 storage_entry(5, true),
                 storage_entry(6, false),
+                storage_entry(7, true),
             ],
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -211,6 +213,7 @@ impl GpuRenderer {
                 wgpu::BindGroupEntry { binding: 4, resource: materials.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 5, resource: lights.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 6, resource: film_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 7, resource: env.as_entire_binding() },
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -226,7 +229,7 @@ impl GpuRenderer {
             compilation_options: Default::default(),
             cache: None,
         });
-        let gpu_bytes = [&nodes, &triangles, &normals, &materials, &lights, &film_buf, &params_buf]
+        let gpu_bytes = [&nodes, &triangles, &normals, &materials, &lights, &env, &film_buf, &params_buf]
             .iter()
             .map(|b| b.size())
             .sum::<u64>();

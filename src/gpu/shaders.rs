@@ -13,6 +13,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("camera.wgsl", include_str!("../../shaders/camera.wgsl")),
     ("microfacet.wgsl", include_str!("../../shaders/microfacet.wgsl")),
     ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
+    ("environment.wgsl", include_str!("../../shaders/environment.wgsl")),
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
     ("integrator.wgsl", include_str!("../../shaders/integrator.wgsl")),
 ];

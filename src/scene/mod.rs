@@ -4,9 +4,11 @@
 //! already converted to the renderer's conventions (linear RGB, radiance).
 
 pub mod camera;
+pub mod environment;
 pub mod gltf;
 
 pub use camera::Camera;
+pub use environment::EnvironmentMap;
 use glam::Vec3;
 
 /// One world-space triangle. Counter-clockwise winding is the front face.
@@ -95,8 +97,10 @@ pub struct Scene {
     pub triangles: Vec<Triangle>,
     pub materials: Vec<Material>,
     pub cameras: Vec<Camera>,
-    /// Constant environment radiance seen by rays that leave the scene.
+    /// Environment radiance seen by rays that leave the scene: a constant color, or the
+    /// scale of `environment_map` when there is one.
     pub environment: Vec3,
+    pub environment_map: Option<EnvironmentMap>,
 }
 
 impl Scene {

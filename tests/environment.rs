@@ -1,0 +1,137 @@
+//! Environment maps: importance sampling agrees with its pdf, the pdf is normalised, and maps
+//! render the same on both backends (and a constant map is a white furnace).
+
+mod common;
+
+use common::*;
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+use veach::cpu::environment::{env_direction, environment_pdf, environment_radiance, sample_environment};
+use veach::packed::PackedScene;
+use veach::params::Params;
+use veach::scene::{EnvironmentMap, Scene};
+use veach::{Strategy, Tile};
+
+/// A sky: a dim gradient, a bright small sun, and a black band (pdf 0 there).
+fn sky(w: u32, h: u32) -> EnvironmentMap {
+    let mut m = EnvironmentMap::constant(w, h, Vec3::ZERO);
+    for i in 0..h {
+        for j in 0..w {
+            let v = (i as f32 + 0.5) / h as f32;
+            let mut c = Vec3::new(0.2, 0.4, 1.0) * (1.0 - v) + Vec3::splat(0.05);
+            if (i as i32 - h as i32 / 4).abs() <= 1 && (j as i32 - w as i32 / 3).abs() <= 1 {
+                c = Vec3::new(400.0, 350.0, 300.0);
+            }
+            if i > h * 3 / 4 {
+                c = Vec3::ZERO;
+            }
+            m.texels[(i * w + j) as usize] = c;
+        }
+    }
+    m
+}
+
+fn setup(map: EnvironmentMap) -> (PackedScene, Params) {
+    let scene = Scene { environment: Vec3::ONE, environment_map: Some(map), ..Default::default() };
+    let packed = PackedScene::new(&scene);
+    let camera = scene.camera(None).expect("default camera");
+    let tile = Tile { x: 0, y: 0, width: 4, height: 4 };
+    let params = Params::new(&camera, (4, 4), tile, 0, 8, Strategy::MisPower, Vec3::ONE, &packed);
+    (packed, params)
+}
+
+struct Lcg(u64);
+impl Lcg {
+    fn f(&mut self) -> f32 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+#[test]
+fn environment_pdf_integrates_to_one() {
+    let (scene, params) = setup(sky(64, 32));
+    assert_eq!(params.env_select, 1.0, "no triangle lights: the environment is all of light sampling");
+    let (nu, nv) = (1024, 512);
+    let mut total = 0.0f64;
+    for i in 0..nv {
+        for j in 0..nu {
+            let uv = Vec2::new((j as f32 + 0.5) / nu as f32, (i as f32 + 0.5) / nv as f32);
+            let dir = env_direction(uv);
+            let dw = 2.0 * PI * PI * (PI * uv.y).sin() / (nu * nv) as f32;
+            total += (environment_pdf(&scene, &params, dir) * dw) as f64;
+        }
+    }
+    assert!((total - 1.0).abs() < 2e-3, "∫ pdf dω = {total}");
+}
+
+#[test]
+fn sampling_estimates_the_integral_of_the_map() {
+    let map = sky(64, 32);
+    let (scene, params) = setup(map.clone());
+    // Exact: Σ texel × its solid angle (2π/W)(cos θ0 − cos θ1).
+    let mut exact = Vec3::ZERO.as_dvec3();
+    for i in 0..map.height {
+        let t0 = PI * i as f32 / map.height as f32;
+        let t1 = PI * (i + 1) as f32 / map.height as f32;
+        let dw = 2.0 * PI / map.width as f32 * (t0.cos() - t1.cos());
+        for j in 0..map.width {
+            exact += (map.texels[(i * map.width + j) as usize] * dw).as_dvec3();
+        }
+    }
+    let mut rng = Lcg(3);
+    let n = 400_000;
+    let (mut sum, mut sum2) = (Vec3::ZERO.as_dvec3(), Vec3::ZERO.as_dvec3());
+    for _ in 0..n {
+        let dir = sample_environment(&scene, &params, Vec2::new(rng.f(), rng.f()));
+        let pdf = environment_pdf(&scene, &params, dir);
+        assert!(pdf > 0.0, "sampled a direction of zero density: {dir}");
+        let x = (environment_radiance(&scene, &params, dir) / pdf).as_dvec3();
+        sum += x;
+        sum2 += x * x;
+    }
+    let mean = sum / n as f64;
+    let se = ((sum2 / n as f64 - mean * mean) / n as f64).max(glam::DVec3::ZERO).sqrt();
+    for c in 0..3 {
+        assert!(
+            (mean[c] - exact[c]).abs() < 4.0 * se[c] + 1e-3 * exact[c],
+            "estimate {mean} vs exact {exact} (se {se})"
+        );
+    }
+    // Importance sampling ∝ luminance: the luminance estimate is nearly constant.
+    assert!(veach::packed::luminance(se.as_vec3()) < 0.01 * veach::packed::luminance(exact.as_vec3()));
+}
+
+fn furnace_with_map(map: EnvironmentMap, ctx: Option<veach::gpu::GpuContext>, seed: u32) -> veach::film::Film {
+    let (mut scene, camera) = veach::load(&asset("furnace-a080.gltf"), None).expect("scene");
+    scene.environment = Vec3::ONE;
+    scene.environment_map = Some(map);
+    let packed = PackedScene::new(&scene);
+    let backend = if ctx.is_some() { veach::Backend::Gpu } else { veach::Backend::Cpu };
+    let mut r = veach::Renderer::with_gpu(packed, &camera, &settings(48, 8, seed), backend, ctx).expect("renderer");
+    r.render_samples(0, 64).expect("render");
+    r.film().expect("film")
+}
+
+#[test]
+fn constant_map_is_a_constant_environment() {
+    // The grey furnace lit by a constant map equals the same furnace lit by a constant color.
+    let film = furnace_with_map(EnvironmentMap::constant(16, 8, Vec3::ONE), None, 1);
+    let constant = render(&asset("furnace-a080.gltf"), &settings(48, 8, 2), 64, None);
+    let (a, va) = film_stats(&film);
+    let (b, vb) = film_stats(&constant);
+    let agree = agreement(&a, &va, &b, &vb);
+    assert!(agree.mean_z.abs().max_element() < 5.0 && agree.outliers < 0.005, "{agree:?}");
+}
+
+#[test]
+fn gpu_and_cpu_agree_under_a_sky() {
+    let Some(ctx) = gpu("gpu_and_cpu_agree_under_a_sky") else { return };
+    let g = furnace_with_map(sky(64, 32), Some(ctx), 3);
+    let c = furnace_with_map(sky(64, 32), None, 4);
+    let (gm, gv) = film_stats(&g);
+    let (cm, cv) = film_stats(&c);
+    let a = agreement(&gm, &gv, &cm, &cv);
+    eprintln!("sky gpu vs cpu: {a:?}");
+    assert!(a.mean_z.abs().max_element() < 5.0 && a.mean_rel.abs().max_element() < 0.02 && a.outliers < 0.01, "{a:?}");
+}
