@@ -9,5 +9,6 @@
 @group(0) @binding(5) var<storage, read> lights: array<LightEntry>;
 // Environment map texels (rgb, row CDF), then the marginal CDF of the rows (x).
 @group(0) @binding(7) var<storage, read> env_texels: array<vec4<f32>>;
-// Two rows per pixel: (Σ L, sample count) and (Σ L², dropped non-finite samples).
-@group(0) @binding(6) var<storage, read_write> film: array<vec4<f32>>;
+// Three rows per pixel (see film.wgsl): (Σ L high words, count), (Σ L low words, dropped
+// non-finite samples), (Σ L² as f32 bits, 0).
+@group(0) @binding(6) var<storage, read_write> film: array<vec4<u32>>;

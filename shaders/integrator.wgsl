@@ -8,6 +8,7 @@
 #include "bsdf.wgsl"
 #include "lights.wgsl"
 #include "mis.wgsl"
+#include "film.wgsl"
 
 fn shading_normal(tri: Triangle, index: u32, u: f32, v: f32, ng: vec3<f32>) -> vec3<f32> {
     if ((tri.flags & TRI_HAS_NORMALS) == 0u) {
@@ -147,12 +148,5 @@ fn render_sample(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pixel = vec2<u32>(gid.x + params.tile_x, gid.y + params.tile_y);
     var rng = rng_init(pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
     let ray = generate_ray(pixel, rng_next2(&rng));
-    let l = li(ray, &rng);
-    let i = 2u * (gid.y * params.film_width + gid.x);
-    if (is_finite_vec3(l)) {
-        film[i] += vec4<f32>(l, 1.0);
-        film[i + 1u] += vec4<f32>(l * l, 0.0);
-    } else {
-        film[i + 1u].w += 1.0;
-    }
+    film_add_sample(gid.y * params.film_width + gid.x, li(ray, &rng));
 }

@@ -1,92 +1,170 @@
-//! The film: per-pixel sums (never a running mean) so films merge exactly, plus the sums of
-//! squares that give each pixel's sample variance. Layout = the GPU buffer's: per pixel
-//! `[Σr, Σg, Σb, n, Σr², Σg², Σb², dropped non-finite samples]`.
+//! The film: per-pixel sums of samples, never a running mean. Twin: `shaders/film.wgsl`.
+//!
+//! Radiance sums are 64-bit fixed point (32 integer bits, 32 fraction bits, kept as two u32
+//! words): integer addition is associative, so films of disjoint sample ranges or tiles,
+//! rendered anywhere, merge into exactly the film of one uninterrupted render. Each sample is
+//! converted exactly unless it is below 2^-9 (then it is truncated to a multiple of 2^-32)
+//! or above 2^31 (clamped). Sums of squares (for per-pixel variance) are plain f32.
+//!
+//! Per pixel, 12 words: `[hi.r, hi.g, hi.b, count, lo.r, lo.g, lo.b, dropped non-finite
+//! samples, Σr² (f32 bits), Σg², Σb², 0]`.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
-pub const FLOATS_PER_PIXEL: usize = 8;
+pub const WORDS_PER_PIXEL: usize = 12;
+
+/// Largest radiance one sample may add (the largest f32 below 2^31).
+pub const MAX_SAMPLE: f32 = 2147483520.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     pub width: u32,
     pub height: u32,
-    pub data: Vec<f32>,
+    pub data: Vec<u32>,
+}
+
+/// A sample's value as 32.32 fixed point: (integer part, fraction × 2^32).
+pub fn to_fixed(x: f32) -> (u32, u32) {
+    let c = x.clamp(0.0, MAX_SAMPLE);
+    let hi = c.floor();
+    ((hi as u32), ((c - hi) * 4294967296.0) as u32)
 }
 
 impl Film {
     pub fn new(width: u32, height: u32) -> Film {
-        Film { width, height, data: vec![0.0; width as usize * height as usize * FLOATS_PER_PIXEL] }
+        Film { width, height, data: vec![0; width as usize * height as usize * WORDS_PER_PIXEL] }
     }
 
     pub fn pixel_count(&self) -> usize {
         self.width as usize * self.height as usize
     }
 
-    fn px(&self, i: usize) -> &[f32] {
-        &self.data[i * FLOATS_PER_PIXEL..(i + 1) * FLOATS_PER_PIXEL]
+    fn px(&self, i: usize) -> &[u32] {
+        &self.data[i * WORDS_PER_PIXEL..(i + 1) * WORDS_PER_PIXEL]
     }
 
-    /// Adds one sample; non-finite samples are dropped and counted.
+    /// Adds one sample; non-finite samples are dropped and counted. Twin of `film_add_sample`.
     pub fn add_sample(&mut self, i: usize, l: Vec3) {
-        let p = &mut self.data[i * FLOATS_PER_PIXEL..(i + 1) * FLOATS_PER_PIXEL];
-        if l.is_finite() {
-            p[0] += l.x;
-            p[1] += l.y;
-            p[2] += l.z;
-            p[3] += 1.0;
-            p[4] += l.x * l.x;
-            p[5] += l.y * l.y;
-            p[6] += l.z * l.z;
-        } else {
-            p[7] += 1.0;
+        let p = &mut self.data[i * WORDS_PER_PIXEL..(i + 1) * WORDS_PER_PIXEL];
+        if !l.is_finite() {
+            p[7] = p[7].wrapping_add(1);
+            return;
         }
+        for c in 0..3 {
+            let (hi, lo) = to_fixed(l[c]);
+            let (sum_lo, carry) = p[4 + c].overflowing_add(lo);
+            p[4 + c] = sum_lo;
+            p[c] = p[c].wrapping_add(hi).wrapping_add(carry as u32);
+            p[8 + c] = (f32::from_bits(p[8 + c]) + l[c] * l[c]).to_bits();
+        }
+        p[3] = p[3].wrapping_add(1);
     }
 
-    pub fn count(&self, i: usize) -> f32 {
+    pub fn count(&self, i: usize) -> u32 {
         self.px(i)[3]
+    }
+
+    pub fn nonfinite(&self, i: usize) -> u32 {
+        self.px(i)[7]
+    }
+
+    /// Σ L of pixel `i`, exactly (as f64).
+    pub fn sum(&self, i: usize) -> DVec3 {
+        let p = self.px(i);
+        let ch = |c: usize| p[c] as f64 + p[4 + c] as f64 * (1.0 / 4294967296.0);
+        DVec3::new(ch(0), ch(1), ch(2))
     }
 
     /// Mean radiance of pixel `i` (0 with no samples).
     pub fn mean(&self, i: usize) -> Vec3 {
-        let p = self.px(i);
-        if p[3] > 0.0 { Vec3::new(p[0], p[1], p[2]) / p[3] } else { Vec3::ZERO }
+        let n = self.count(i);
+        if n == 0 { Vec3::ZERO } else { (self.sum(i) / n as f64).as_vec3() }
     }
 
     /// Unbiased sample variance of one sample of pixel `i`.
     pub fn sample_variance(&self, i: usize) -> Vec3 {
-        let p = self.px(i);
-        let n = p[3];
+        let n = self.count(i) as f64;
         if n < 2.0 {
             return Vec3::ZERO;
         }
-        let mean = Vec3::new(p[0], p[1], p[2]) / n;
-        let sq = Vec3::new(p[4], p[5], p[6]) / n;
-        ((sq - mean * mean) * (n / (n - 1.0))).max(Vec3::ZERO)
+        let p = self.px(i);
+        let sq = DVec3::new(f32::from_bits(p[8]) as f64, f32::from_bits(p[9]) as f64, f32::from_bits(p[10]) as f64);
+        let mean = self.sum(i) / n;
+        ((sq / n - mean * mean) * (n / (n - 1.0))).max(DVec3::ZERO).as_vec3()
     }
 
     /// Variance of the pixel's mean estimate (sample variance / n).
     pub fn variance_of_mean(&self, i: usize) -> Vec3 {
-        let n = self.count(i).max(1.0);
-        self.sample_variance(i) / n
+        self.sample_variance(i) / self.count(i).max(1) as f32
     }
 
-    pub fn means(&self) -> Vec<Vec3> {
-        (0..self.pixel_count()).map(|i| self.mean(i)).collect()
-    }
-
-    /// Samples per pixel (the minimum over pixels; all pixels agree unless samples were dropped).
-    pub fn spp(&self) -> u32 {
-        (0..self.pixel_count()).map(|i| self.count(i) + self.px(i)[7]).fold(f32::INFINITY, f32::min) as u32
+    /// Samples per pixel taken (accumulated or dropped; the same for every pixel).
+    pub fn samples(&self) -> u32 {
+        (0..self.pixel_count()).map(|i| self.count(i) + self.nonfinite(i)).min().unwrap_or(0)
     }
 
     pub fn nonfinite_samples(&self) -> u64 {
-        (0..self.pixel_count()).map(|i| self.px(i)[7] as u64).sum()
+        (0..self.pixel_count()).map(|i| self.nonfinite(i) as u64).sum()
     }
 
-    /// Adds another film of the same size (sample ranges rendered separately).
+    /// Adds another film's samples pixel by pixel, exactly.
     pub fn merge(&mut self, other: &Film) {
-        for (a, b) in self.data.iter_mut().zip(&other.data) {
-            *a += b;
+        self.merge_at(other, 0, 0);
+    }
+
+    /// Adds a film covering the window at (x, y) of this one.
+    pub fn merge_at(&mut self, other: &Film, x: u32, y: u32) {
+        for oy in 0..other.height {
+            for ox in 0..other.width {
+                let src = other.px((oy * other.width + ox) as usize).to_vec();
+                let i = ((y + oy) * self.width + x + ox) as usize;
+                let p = &mut self.data[i * WORDS_PER_PIXEL..(i + 1) * WORDS_PER_PIXEL];
+                for c in 0..3 {
+                    let (lo, carry) = p[4 + c].overflowing_add(src[4 + c]);
+                    p[4 + c] = lo;
+                    p[c] = p[c].wrapping_add(src[c]).wrapping_add(carry as u32);
+                    p[8 + c] = (f32::from_bits(p[8 + c]) + f32::from_bits(src[8 + c])).to_bits();
+                }
+                p[3] += src[3];
+                p[7] += src[7];
+            }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fixed_point_is_exact_and_merges_associatively() {
+        for x in [0.0f32, 1.0, 0.5, 17.25, 1e-3, 123456.78, 3.0e9] {
+            let (hi, lo) = to_fixed(x);
+            let back = hi as f64 + lo as f64 / 4294967296.0;
+            let expect = x.min(MAX_SAMPLE) as f64;
+            assert!((back - expect).abs() <= 2.4e-10, "{x}: {back}");
+        }
+        let samples: Vec<Vec3> =
+            (0..64).map(|k| Vec3::new(k as f32 * 0.37 + 0.001, (k as f32).sin().abs() * 9.0, 1e-4 * k as f32)).collect();
+        let mut whole = Film::new(1, 1);
+        samples.iter().for_each(|s| whole.add_sample(0, *s));
+        let (mut a, mut b) = (Film::new(1, 1), Film::new(1, 1));
+        samples[..23].iter().for_each(|s| a.add_sample(0, *s));
+        samples[23..].iter().for_each(|s| b.add_sample(0, *s));
+        b.merge(&a);
+        assert_eq!(whole.data[..8], b.data[..8], "sums and counts merge bit-exactly in any order");
+        assert_eq!(whole.count(0), 64);
+        let mean: Vec3 = samples.iter().sum::<Vec3>() / 64.0;
+        assert!((whole.mean(0) - mean).abs().max_element() < 1e-5);
+    }
+
+    #[test]
+    fn non_finite_samples_are_dropped_and_counted() {
+        let mut f = Film::new(2, 1);
+        f.add_sample(1, Vec3::new(f32::NAN, 0.0, 0.0));
+        f.add_sample(1, Vec3::new(1.0, f32::INFINITY, 0.0));
+        f.add_sample(1, Vec3::ONE);
+        assert_eq!((f.count(1), f.nonfinite(1), f.nonfinite_samples()), (1, 2, 2));
+        assert_eq!(f.mean(1), Vec3::ONE);
     }
 }

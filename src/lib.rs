@@ -210,7 +210,7 @@ impl Renderer {
             Engine::Cpu(film) => {
                 let (scene, base) = (&self.scene, self.params);
                 let width = base.film_width as usize;
-                film.data.par_chunks_mut(width * film::FLOATS_PER_PIXEL).enumerate().for_each(|(y, row)| {
+                film.data.par_chunks_mut(width * film::WORDS_PER_PIXEL).enumerate().for_each(|(y, row)| {
                     let mut row_film = Film { width: base.film_width, height: 1, data: row.to_vec() };
                     for s in start..start + count {
                         let mut p = base;

@@ -4,7 +4,7 @@
 pub mod shaders;
 
 use crate::Error;
-use crate::film::{FLOATS_PER_PIXEL, Film};
+use crate::film::{Film, WORDS_PER_PIXEL};
 use crate::packed::PackedScene;
 use crate::params::Params;
 use std::sync::{Arc, Mutex};
@@ -110,7 +110,7 @@ impl GpuRenderer {
         let device = &ctx.device;
         let limits = device.limits();
         let pixels = params.film_width as u64 * params.film_height as u64;
-        let film_bytes = pixels * (FLOATS_PER_PIXEL * 4) as u64;
+        let film_bytes = pixels * (WORDS_PER_PIXEL * 4) as u64;
 
         let storage = |label: &str, bytes: &[u8]| -> Result<wgpu::Buffer, Error> {
             let len = bytes.len() as u64;

@@ -15,6 +15,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
     ("environment.wgsl", include_str!("../../shaders/environment.wgsl")),
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
+    ("film.wgsl", include_str!("../../shaders/film.wgsl")),
     ("integrator.wgsl", include_str!("../../shaders/integrator.wgsl")),
 ];
 

@@ -1,0 +1,26 @@
+// Accumulation into the film: 64-bit fixed-point sums (two u32 words), so that films of
+// sample ranges and tiles merge exactly. Twin: src/film.rs (layout and arithmetic there).
+#include "bindings.wgsl"
+
+const FILM_WORDS: u32 = 3u; // vec4<u32> rows per pixel
+const MAX_SAMPLE: f32 = 2147483520.0;
+
+fn film_add_sample(pixel: u32, l: vec3<f32>) {
+    let base = FILM_WORDS * pixel;
+    if (!is_finite_vec3(l)) {
+        film[base + 1u].w += 1u;
+        return;
+    }
+    let c = clamp(l, vec3<f32>(0.0), vec3<f32>(MAX_SAMPLE));
+    let hi = floor(c);
+    let add_hi = vec3<u32>(hi);
+    let add_lo = vec3<u32>((c - hi) * 4294967296.0);
+    let sum_hi = film[base];
+    let sum_lo = film[base + 1u];
+    let lo = sum_lo.xyz + add_lo;
+    let carry = select(vec3<u32>(0u), vec3<u32>(1u), lo < sum_lo.xyz);
+    film[base] = vec4<u32>(sum_hi.xyz + add_hi + carry, sum_hi.w + 1u);
+    film[base + 1u] = vec4<u32>(lo, sum_lo.w);
+    let sq = bitcast<vec3<f32>>(film[base + 2u].xyz) + l * l;
+    film[base + 2u] = vec4<u32>(bitcast<vec3<u32>>(sq), 0u);
+}
