@@ -46,7 +46,8 @@ impl fmt::Display for Error {
 impl std::error::Error for Error {}
 
 /// The four direct-lighting estimators of the seed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 #[repr(u32)]
 pub enum Strategy {
     /// BSDF sampling only: emission counts when a BSDF-sampled ray hits an emitter.
@@ -77,7 +78,7 @@ pub enum Backend {
 }
 
 /// A crop window of the image (the whole image by default).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Tile {
     pub x: u32,
     pub y: u32,
@@ -110,6 +111,46 @@ impl Default for Settings {
             environment: None,
             tile: None,
         }
+    }
+}
+
+/// Everything that defines a render, saved in every EXR veach writes so that a render can be
+/// resumed and its parts merged.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Job {
+    pub scene: std::path::PathBuf,
+    pub camera: Option<String>,
+    pub width: u32,
+    pub height: u32,
+    pub max_depth: u32,
+    pub seed: u32,
+    pub strategy: Strategy,
+    pub env_map: Option<std::path::PathBuf>,
+    pub env_color: Option<[f32; 3]>,
+    pub env_strength: f32,
+    /// The crop window rendered (None: the whole image).
+    pub tile: Option<Tile>,
+    /// Sample indices `sample_start .. sample_end` make up this render.
+    pub sample_start: u32,
+    pub sample_end: u32,
+}
+
+impl Job {
+    pub fn settings(&self) -> Settings {
+        Settings {
+            width: self.width,
+            height: self.height,
+            max_depth: self.max_depth,
+            seed: self.seed,
+            strategy: self.strategy,
+            camera: self.camera.clone(),
+            environment: None,
+            tile: self.tile,
+        }
+    }
+
+    pub fn window(&self) -> Tile {
+        self.tile.unwrap_or(Tile { x: 0, y: 0, width: self.width, height: self.height })
     }
 }
 

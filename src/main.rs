@@ -5,7 +5,9 @@ use glam::Vec3;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use veach::{Backend, Error, Renderer, Settings, Strategy};
+use std::sync::atomic::{AtomicBool, Ordering};
+use veach::film::Film;
+use veach::{Backend, Error, Job, Renderer, Settings, Strategy, Tile};
 
 #[derive(Parser)]
 #[command(
@@ -22,10 +24,24 @@ struct Cli {
 enum Command {
     /// Render a glTF 2.0 scene (.gltf/.glb) to a PNG (tone-mapped) or EXR (linear).
     Render(RenderArgs),
+    /// Merge renders of disjoint sample ranges or tiles (EXRs written by veach) into one image.
+    Merge(MergeArgs),
     /// Render the seed's four direct-lighting estimators at equal spp, side by side with labels.
     Strategies(StrategiesArgs),
     /// List the Vulkan adapters and their limits.
     Info,
+}
+
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// The parts: EXR files written by `veach render` (with --sample-range or --tile).
+    #[arg(required = true)]
+    parts: Vec<PathBuf>,
+    /// The merged image (.exr keeps the film, .png is tone-mapped).
+    #[arg(short, long)]
+    output: PathBuf,
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    exposure: f32,
 }
 
 #[derive(clap::Args)]
@@ -67,9 +83,11 @@ struct StrategiesArgs {
 
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// The scene, a .gltf or .glb file.
-    scene: PathBuf,
-    /// Output image; the extension picks the format: .png (exposure, clamp, sRGB) or .exr (linear f32 RGB).
+    /// The scene, a .gltf or .glb file (not needed with --resume).
+    #[arg(required_unless_present = "resume")]
+    scene: Option<PathBuf>,
+    /// Output image; the extension picks the format: .png (exposure, clamp, sRGB) or .exr
+    /// (linear f32 RGB, plus the film and the job so that it can be resumed or merged).
     #[arg(short, long)]
     output: PathBuf,
     /// Samples per pixel.
@@ -108,9 +126,46 @@ struct RenderArgs {
     /// Scales the environment (map or color).
     #[arg(long, default_value_t = 1.0)]
     env_strength: f32,
+    /// Render only sample indices START..END (a render-farm split; overrides --spp). Random
+    /// numbers are keyed by sample index, so parts merge (`veach merge`) into the full render.
+    #[arg(long, value_parser = parse_range)]
+    sample_range: Option<(u32, u32)>,
+    /// Render only the window X,Y,W,H of the image (an image-space split, merged by `veach merge`).
+    #[arg(long, value_parser = parse_tile)]
+    tile: Option<Tile>,
+    /// Save the film and the job to this EXR periodically and at exit, for --resume.
+    #[arg(long)]
+    checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints.
+    #[arg(long, default_value_t = 60.0)]
+    checkpoint_every: f64,
+    /// Continue the render saved in this checkpoint (or any EXR veach wrote) to its target.
+    #[arg(long)]
+    resume: Option<PathBuf>,
     /// Write render statistics as JSON.
     #[arg(long)]
     stats_json: Option<PathBuf>,
+}
+
+fn parse_range(s: &str) -> Result<(u32, u32), String> {
+    let (a, b) = s.split_once("..").ok_or("expected START..END, e.g. 0..32")?;
+    let a: u32 = a.trim().parse().map_err(|e| format!("'{a}': {e}"))?;
+    let b: u32 = b.trim().parse().map_err(|e| format!("'{b}': {e}"))?;
+    if b <= a {
+        return Err(format!("{a}..{b} is empty"));
+    }
+    Ok((a, b))
+}
+
+fn parse_tile(s: &str) -> Result<Tile, String> {
+    let v: Vec<u32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<u32>().map_err(|e| format!("'{x}': {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y, width, height] if width > 0 && height > 0 => Ok(Tile { x, y, width, height }),
+        _ => Err("expected X,Y,W,H with W, H > 0".into()),
+    }
 }
 
 fn parse_rgb(s: &str) -> Result<Vec3, String> {
@@ -128,11 +183,13 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render(&args),
-        Command::Strategies(args) => strategies(&args),
-        Command::Info => info(),
+        Command::Merge(args) => merge(&args),
+        Command::Strategies(args) => strategies(&args).map(|_| Outcome::Done),
+        Command::Info => info().map(|_| Outcome::Done),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(Outcome::Done) => ExitCode::SUCCESS,
+        Ok(Outcome::Interrupted) => ExitCode::from(EXIT_INTERRUPTED),
         Err(e) => {
             eprintln!("veach: {e}");
             ExitCode::from(2)
@@ -179,87 +236,145 @@ fn info() -> Result<(), Error> {
     Ok(())
 }
 
-fn render(args: &RenderArgs) -> Result<(), Error> {
+/// Set by SIGINT/SIGTERM: finish the dispatch in flight, save, exit 130.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Exit status of an interrupted render that kept its work.
+const EXIT_INTERRUPTED: u8 = 130;
+
+fn render(args: &RenderArgs) -> Result<Outcome, Error> {
     let t0 = Instant::now();
     veach::output::check_output(&args.output)?;
-    if let Some(stats) = &args.stats_json {
-        check_writable(stats)?;
+    for path in [&args.stats_json, &args.checkpoint].into_iter().flatten() {
+        check_writable(path)?;
     }
-    if args.spp == 0 {
-        return Err(Error::Input("--spp must be at least 1".into()));
-    }
-    let (mut scene, camera) = veach::load(&args.scene, args.camera.as_deref())?;
-    set_environment(&mut scene, args.env.as_deref(), args.env_color, args.env_strength)?;
+    // The job: from a checkpoint, or from the command line.
+    let (job, resumed) = match &args.resume {
+        Some(path) => {
+            let (film, job) = veach::output::read_film(path)?;
+            (job, Some(film))
+        }
+        None => {
+            let scene = args.scene.clone().ok_or_else(|| Error::Input("a SCENE is required".into()))?;
+            let (sample_start, sample_end) = args.sample_range.unwrap_or((0, args.spp));
+            if sample_end <= sample_start {
+                return Err(Error::Input("--spp must be at least 1".into()));
+            }
+            let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+            let job = Job {
+                scene: absolute(&scene),
+                camera: args.camera.clone(),
+                width: args.width,
+                height: args.height,
+                max_depth: args.max_depth,
+                seed: args.seed,
+                strategy: args.strategy,
+                env_map: args.env.as_deref().map(absolute),
+                env_color: args.env_color.map(Into::into),
+                env_strength: args.env_strength,
+                tile: args.tile,
+                sample_start,
+                sample_end,
+            };
+            (job, None)
+        }
+    };
+    let (mut scene, camera) = veach::load(&job.scene, job.camera.as_deref())?;
+    set_environment(&mut scene, job.env_map.as_deref(), job.env_color.map(Vec3::from), job.env_strength)?;
     let triangles = scene.triangles.len();
     if scene.emissive_triangle_count() == 0 && scene.environment == Vec3::ZERO {
         eprintln!(
             "veach: warning: {}: the scene has no lights and no environment; the image will be black",
-            args.scene.display()
+            job.scene.display()
         );
     }
     let packed = veach::packed::PackedScene::new(&scene);
     let (bvh_nodes, bvh_seconds) = (packed.nodes.len(), packed.bvh_build_seconds);
-    let settings = Settings {
-        width: args.width,
-        height: args.height,
-        max_depth: args.max_depth,
-        seed: args.seed,
-        strategy: args.strategy,
-        camera: args.camera.clone(),
-        environment: None,
-        tile: None,
-    };
-    let mut renderer = open_renderer(packed, &camera, &settings, args.backend)?;
+    let mut renderer = open_renderer(packed, &camera, &job.settings(), args.backend)?;
+    let mut done = 0u32;
+    if let Some(film) = resumed {
+        let window = job.window();
+        if (film.width, film.height) != (window.width, window.height) {
+            return Err(Error::Input("the checkpoint's film does not match its job".into()));
+        }
+        done = film.samples();
+        renderer.set_film(&film);
+    }
+    let total = job.sample_end - job.sample_start;
+    // Ctrl-C and SIGTERM stop the loop between dispatches; the work done is kept.
+    let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
 
-    let bar = indicatif::ProgressBar::new(args.spp as u64);
+    let bar = indicatif::ProgressBar::new(total as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{elapsed_precise} {wide_bar} {pos}/{len} spp  {msg}  ETA {eta}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let pixels = args.width as f64 * args.height as f64;
+    bar.set_position(done as u64);
+    let window = job.window();
+    let pixels = window.width as f64 * window.height as f64;
     let t_render = Instant::now();
-    let mut done = 0u32;
-    let mut chunk = 1u32;
-    while done < args.spp {
-        let n = chunk.min(args.spp - done);
+    let mut last_checkpoint = Instant::now();
+    let (mut chunk, first) = (1u32, done);
+    while done < total && !INTERRUPTED.load(Ordering::SeqCst) {
+        let n = chunk.min(total - done);
         let t = Instant::now();
-        renderer.render_samples(done, n)?;
+        renderer.render_samples(job.sample_start + done, n)?;
         done += n;
-        // Aim for about a quarter second per chunk: responsive progress, few round trips.
+        // Aim for about a quarter second per chunk: responsive to Ctrl-C, few round trips.
         let secs = t.elapsed().as_secs_f64().max(1e-6);
         chunk = ((n as f64 * 0.25 / secs) as u32).clamp(1, veach::gpu::MAX_BATCH);
         bar.set_position(done as u64);
-        let rate = done as f64 * pixels / t_render.elapsed().as_secs_f64().max(1e-9);
+        let rate = (done - first) as f64 * pixels / t_render.elapsed().as_secs_f64().max(1e-9);
         bar.set_message(format!("{:.2} Msamples/s", rate / 1e6));
+        if let Some(path) = &args.checkpoint
+            && last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every
+            && done < total
+        {
+            veach::output::write(&renderer.film()?, path, 0.0, Some(&job))?;
+            last_checkpoint = Instant::now();
+        }
     }
+    let interrupted = done < total;
     let film = renderer.film()?;
     let seconds_render = t_render.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    veach::output::write(&film, &args.output, args.exposure)?;
+    veach::output::write(&film, &args.output, args.exposure, Some(&job))?;
+    if let Some(path) = &args.checkpoint {
+        veach::output::write(&film, path, 0.0, Some(&job))?;
+    }
     let nonfinite = film.nonfinite_samples();
     if nonfinite > 0 {
         eprintln!("veach: warning: dropped {nonfinite} non-finite samples");
     }
-    let samples_per_second = args.spp as f64 * pixels / seconds_render;
-    eprintln!(
-        "veach: wrote {} ({}x{}, {} spp, {}, {:.2} s, {:.2} Msamples/s)",
-        args.output.display(),
-        args.width,
-        args.height,
-        args.spp,
-        renderer.adapter_name(),
-        seconds_render,
-        samples_per_second / 1e6
-    );
+    let rendered = (done - first) as f64 * pixels;
+    let samples_per_second = rendered / seconds_render.max(1e-9);
+    if interrupted {
+        eprintln!("veach: interrupted: wrote {} with {done} of {total} spp", args.output.display());
+    } else {
+        eprintln!(
+            "veach: wrote {} ({}x{}, {} spp, {}, {:.2} s, {:.2} Msamples/s)",
+            args.output.display(),
+            window.width,
+            window.height,
+            total,
+            renderer.adapter_name(),
+            seconds_render,
+            samples_per_second / 1e6
+        );
+    }
     if let Some(path) = &args.stats_json {
         let stats = serde_json::json!({
-            "scene": args.scene.display().to_string(),
-            "width": args.width,
-            "height": args.height,
-            "spp": args.spp,
-            "max_depth": args.max_depth,
-            "seed": args.seed,
-            "strategy": format!("{:?}", args.strategy),
+            "scene": job.scene.display().to_string(),
+            "width": job.width,
+            "height": job.height,
+            "tile": job.tile,
+            "spp": done,
+            "spp_target": total,
+            "sample_start": job.sample_start,
+            "interrupted": interrupted,
+            "max_depth": job.max_depth,
+            "seed": job.seed,
+            "strategy": job.strategy,
             "adapter": renderer.adapter_name(),
             "backend": format!("{:?}", renderer.backend()).to_lowercase(),
             "seconds_total": t0.elapsed().as_secs_f64(),
@@ -273,7 +388,58 @@ fn render(args: &RenderArgs) -> Result<(), Error> {
         });
         write_atomic(path, serde_json::to_string_pretty(&stats).unwrap_or_default().as_bytes())?;
     }
-    Ok(())
+    Ok(if interrupted { Outcome::Interrupted } else { Outcome::Done })
+}
+
+enum Outcome {
+    Done,
+    Interrupted,
+}
+
+fn merge(args: &MergeArgs) -> Result<Outcome, Error> {
+    veach::output::check_output(&args.output)?;
+    let mut parts = Vec::new();
+    for path in &args.parts {
+        parts.push(veach::output::read_film(path)?);
+    }
+    let Some((_, first)) = parts.first() else {
+        return Err(Error::Input("nothing to merge".into()));
+    };
+    let mut job = first.clone();
+    let mut merged = Film::new(job.width, job.height);
+    let mut seen: Vec<(Tile, u32, u32, &Path)> = Vec::new();
+    for ((film, part), path) in parts.iter().zip(&args.parts) {
+        let same = (part.width, part.height, part.seed, part.max_depth, part.strategy, &part.scene, &part.camera)
+            == (job.width, job.height, job.seed, job.max_depth, job.strategy, &job.scene, &job.camera);
+        if !same {
+            return Err(Error::Input(format!(
+                "{}: rendered with other settings than {} (scene, size, seed, depth, strategy and camera must match)",
+                path.display(),
+                args.parts[0].display()
+            )));
+        }
+        let w = part.window();
+        let (start, end) = (part.sample_start, part.sample_start + film.samples());
+        for (t, s, e, other) in &seen {
+            let overlap_px = t.x < w.x + w.width && w.x < t.x + t.width && t.y < w.y + w.height && w.y < t.y + t.height;
+            if overlap_px && *s < end && start < *e {
+                return Err(Error::Input(format!(
+                    "{}: its samples {start}..{end} overlap those of {} in the same pixels",
+                    path.display(),
+                    other.display()
+                )));
+            }
+        }
+        seen.push((w, start, end, path));
+        merged.merge_at(film, w.x, w.y);
+        job.sample_start = job.sample_start.min(start);
+        job.sample_end = job.sample_end.max(end);
+    }
+    // The merged film covers the whole image (pixels no part rendered stay black).
+    job.tile = None;
+    veach::output::write(&merged, &args.output, args.exposure, Some(&job))?;
+    eprintln!("veach: merged {} parts into {}", parts.len(), args.output.display());
+    Ok(Outcome::Done)
 }
 
 /// The environment from the command line: a map (tinted by the color), a color, or the

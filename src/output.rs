@@ -1,8 +1,8 @@
 //! Writing images: PNG (exposure, clamp, sRGB) and EXR (linear f32 RGB), always through a
 //! temporary file renamed into place so a reader never sees a partial image.
 
-use crate::Error;
-use crate::film::Film;
+use crate::film::{Film, WORDS_PER_PIXEL};
+use crate::{Error, Job};
 use std::path::{Path, PathBuf};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -56,18 +56,119 @@ pub fn tonemap(film: &Film, exposure: f32) -> image::RgbImage {
     img
 }
 
-pub fn write(film: &Film, path: &Path, exposure: f32) -> Result<(), Error> {
+/// Writes the film's image: a tone-mapped PNG, or a linear EXR that also carries the film
+/// (sums, counts) and the job, so it can be resumed or merged with other parts.
+pub fn write(film: &Film, path: &Path, exposure: f32, job: Option<&Job>) -> Result<(), Error> {
     match check_output(path)? {
         Format::Png => write_png(&tonemap(film, exposure), path),
-        Format::Exr => {
-            let mut img = image::Rgb32FImage::new(film.width, film.height);
-            for (i, px) in img.pixels_mut().enumerate() {
-                let m = film.mean(i);
-                *px = image::Rgb([m.x, m.y, m.z]);
+        Format::Exr => write_exr(film, path, job),
+    }
+}
+
+/// One text attribute (exr keeps attributes in a hash map: a single one keeps the bytes of
+/// the header deterministic): `{"samples": N, "job": {...}}`.
+const ATTRIBUTE: &str = "veach";
+/// The film's exact words. Sums of squares are not stored: as f32 sums they would not merge
+/// bit-exactly, and merged or resumed renders must equal uninterrupted ones byte for byte.
+const FILM_CHANNELS: [&str; 8] = [
+    "veach.film.hi.R",
+    "veach.film.hi.G",
+    "veach.film.hi.B",
+    "veach.film.count",
+    "veach.film.lo.R",
+    "veach.film.lo.G",
+    "veach.film.lo.B",
+    "veach.film.nonfinite",
+];
+
+/// JSON for an EXR text attribute, which holds Latin-1 only: escape the rest.
+fn ascii_json(value: &serde_json::Value) -> String {
+    let json = value.to_string();
+    let mut out = String::with_capacity(json.len());
+    for ch in json.chars() {
+        if ch.is_ascii() {
+            out.push(ch);
+        } else {
+            let mut buf = [0u16; 2];
+            for unit in ch.encode_utf16(&mut buf) {
+                out.push_str(&format!("\\u{unit:04x}"));
             }
-            save_atomic(path, |tmp| img.save_with_format(tmp, image::ImageFormat::OpenExr))
         }
     }
+    out
+}
+
+fn write_exr(film: &Film, path: &Path, job: Option<&Job>) -> Result<(), Error> {
+    use exr::prelude::*;
+    let n = film.pixel_count();
+    let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
+    let means: Vec<glam::Vec3> = (0..n).map(|i| film.mean(i)).collect();
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        channels.push(AnyChannel::new(*name, FlatSamples::F32(means.iter().map(|m| m[c]).collect())));
+    }
+    for (w, name) in FILM_CHANNELS.iter().enumerate() {
+        let words = (0..n).map(|i| film.data[i * WORDS_PER_PIXEL + w]);
+        channels.push(AnyChannel::new(*name, FlatSamples::U32(words.collect())));
+    }
+    let mut attributes = LayerAttributes::named("veach");
+    let meta = serde_json::json!({ "samples": film.samples(), "job": job });
+    let json = Text::new_or_none(ascii_json(&meta)).unwrap_or_else(|| Text::from("{}"));
+    attributes.other.insert(Text::from(ATTRIBUTE), AttributeValue::Text(json));
+    let size = (film.width as usize, film.height as usize);
+    let layer = Layer::new(size, attributes, Encoding::SMALL_LOSSLESS, AnyChannels::sort(channels.into()));
+    let image = Image::from_layer(layer);
+    save_atomic(path, |tmp| {
+        image.write().to_file(tmp).map_err(|e| image::ImageError::IoError(std::io::Error::other(e.to_string())))
+    })
+}
+
+/// Reads back a film and its job from an EXR written by veach.
+pub fn read_film(path: &Path) -> Result<(Film, Job), crate::Error> {
+    use exr::prelude::*;
+    let fail = |m: String| crate::Error::Input(format!("{}: {m}", path.display()));
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| fail(format!("cannot read EXR: {e}")))?;
+    let layer = &image.layer_data;
+    let job = match layer.attributes.other.get(&Text::from(ATTRIBUTE)) {
+        Some(AttributeValue::Text(t)) => {
+            let meta: serde_json::Value =
+                serde_json::from_str(&t.to_string()).map_err(|e| fail(format!("invalid veach metadata: {e}")))?;
+            serde_json::from_value::<Job>(meta.get("job").cloned().unwrap_or_default())
+                .map_err(|e| fail(format!("no render job in the veach metadata: {e}")))?
+        }
+        _ => return Err(fail("not a veach render (no film metadata)".into())),
+    };
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let window = job.window();
+    if (w, h) != (window.width as usize, window.height as usize) {
+        return Err(fail(format!("film is {w}x{h} but its job says {}x{}", window.width, window.height)));
+    }
+    let mut film = Film::new(w as u32, h as u32);
+    for (k, name) in FILM_CHANNELS.iter().enumerate() {
+        let channel = layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name == Text::from(*name))
+            .ok_or_else(|| fail(format!("missing film channel {name}")))?;
+        let words: Vec<u32> = match &channel.sample_data {
+            FlatSamples::U32(v) => v.clone(),
+            _ => return Err(fail(format!("film channel {name} has the wrong sample type"))),
+        };
+        if words.len() != w * h {
+            return Err(fail(format!("film channel {name} has {} samples, expected {}", words.len(), w * h)));
+        }
+        for (i, word) in words.into_iter().enumerate() {
+            film.data[i * WORDS_PER_PIXEL + k] = word;
+        }
+    }
+    Ok((film, job))
 }
 
 pub fn write_png(img: &image::RgbImage, path: &Path) -> Result<(), Error> {

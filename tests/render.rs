@@ -124,8 +124,8 @@ fn film_bytes(ctx: Option<veach::gpu::GpuContext>, seed: u32) -> (Vec<u8>, Vec<u
         std::env::temp_dir().join(format!("veach-det-{}-{seed}-{:?}", std::process::id(), std::thread::current().id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let (png, exr) = (dir.join("a.png"), dir.join("a.exr"));
-    veach::output::write(&film, &png, 0.0).expect("png");
-    veach::output::write(&film, &exr, 0.0).expect("exr");
+    veach::output::write(&film, &png, 0.0, None).expect("png");
+    veach::output::write(&film, &exr, 0.0, None).expect("exr");
     let out = (std::fs::read(&png).expect("png"), std::fs::read(&exr).expect("exr"));
     let _ = std::fs::remove_dir_all(&dir);
     out
