@@ -1,7 +1,10 @@
 // The scene and film bindings, shared by every kernel.
 #include "common.wgsl"
 
-@group(0) @binding(0) var<uniform> params: Params;
+// One Params slot per dispatch of a batch, bound at a dynamic offset. A storage buffer, not a
+// uniform: lavapipe (Mesa 22.3) inlines uniform values into the shader and compiled, and
+// kept, a new variant on every dispatch: 12 ms and 1.3 MB each (BENCHMARKS.md).
+@group(0) @binding(0) var<storage, read> params: Params;
 @group(0) @binding(1) var<storage, read> nodes: array<BvhNode>;
 @group(0) @binding(2) var<storage, read> triangles: array<Triangle>;
 @group(0) @binding(3) var<storage, read> normals: array<Normals>;

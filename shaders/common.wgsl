@@ -52,7 +52,7 @@ struct LightEntry {
     pmf: f32,
 }
 
-// Per-dispatch parameters. `cam_right` and `cam_up` are pre-scaled by the image-plane half
+// Render parameters; only sample_index changes from dispatch to dispatch. `cam_right` and `cam_up` are pre-scaled by the image-plane half
 // extents so a camera ray is forward + x·right + y·up.
 struct Params {
     cam_position: vec3<f32>,

@@ -144,8 +144,9 @@ mod tests {
             let expect = x.min(MAX_SAMPLE) as f64;
             assert!((back - expect).abs() <= 2.4e-10, "{x}: {back}");
         }
-        let samples: Vec<Vec3> =
-            (0..64).map(|k| Vec3::new(k as f32 * 0.37 + 0.001, (k as f32).sin().abs() * 9.0, 1e-4 * k as f32)).collect();
+        let samples: Vec<Vec3> = (0..64)
+            .map(|k| Vec3::new(k as f32 * 0.37 + 0.001, (k as f32).sin().abs() * 9.0, 1e-4 * k as f32))
+            .collect();
         let mut whole = Film::new(1, 1);
         samples.iter().for_each(|s| whole.add_sample(0, *s));
         let (mut a, mut b) = (Film::new(1, 1), Film::new(1, 1));

@@ -154,6 +154,9 @@ impl Job {
     }
 }
 
+/// Largest film held in memory (CPU) before asking for tiles.
+pub const MAX_FILM_BYTES: u64 = 2 << 30;
+
 /// Largest image side we accept (a GPU texture/dispatch-friendly bound).
 pub const MAX_IMAGE_SIDE: u32 = 16384;
 
@@ -202,6 +205,14 @@ impl Renderer {
         let env = settings.environment.unwrap_or(scene.environment);
         let params =
             Params::new(camera, (w, h), tile, settings.seed, settings.max_depth, settings.strategy, env, &scene);
+        // The film must fit in memory (and, on the GPU, in one storage binding; checked there).
+        let film_bytes = tile.width as u64 * tile.height as u64 * (film::WORDS_PER_PIXEL * 4) as u64;
+        if film_bytes > MAX_FILM_BYTES {
+            return Err(Error::Limit(format!(
+                "a {}x{} film needs {film_bytes} bytes, above veach's limit of {MAX_FILM_BYTES} bytes; render tiles (--tile)",
+                tile.width, tile.height
+            )));
+        }
         let engine = match backend {
             Backend::Cpu => Engine::Cpu(Film::new(tile.width, tile.height)),
             Backend::Gpu => {
@@ -254,8 +265,7 @@ impl Renderer {
                 film.data.par_chunks_mut(width * film::WORDS_PER_PIXEL).enumerate().for_each(|(y, row)| {
                     let mut row_film = Film { width: base.film_width, height: 1, data: row.to_vec() };
                     for s in start..start + count {
-                        let mut p = base;
-                        p.sample_index = s;
+                        let p = Params { sample_index: s, ..base };
                         for x in 0..width {
                             let l = cpu::render_sample(scene, &p, x as u32, y as u32);
                             row_film.add_sample(x, l);
@@ -288,6 +298,9 @@ impl Renderer {
 /// Loads a glTF file into a packed scene and the chosen camera.
 pub fn load(path: &std::path::Path, camera: Option<&str>) -> Result<(scene::Scene, scene::Camera), Error> {
     let scene = scene::gltf::load(path)?;
+    for w in &scene.warnings {
+        eprintln!("veach: warning: {}: {w}", path.display());
+    }
     let cam = scene.camera(camera).map_err(|e| Error::Input(format!("{}: {e}", path.display())))?;
     Ok((scene, cam))
 }

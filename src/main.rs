@@ -4,8 +4,8 @@ use clap::{Parser, Subcommand};
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 use veach::film::Film;
 use veach::{Backend, Error, Job, Renderer, Settings, Strategy, Tile};
 
@@ -158,10 +158,8 @@ fn parse_range(s: &str) -> Result<(u32, u32), String> {
 }
 
 fn parse_tile(s: &str) -> Result<Tile, String> {
-    let v: Vec<u32> = s
-        .split(',')
-        .map(|x| x.trim().parse::<u32>().map_err(|e| format!("'{x}': {e}")))
-        .collect::<Result<_, _>>()?;
+    let v: Vec<u32> =
+        s.split(',').map(|x| x.trim().parse::<u32>().map_err(|e| format!("'{x}': {e}"))).collect::<Result<_, _>>()?;
     match v[..] {
         [x, y, width, height] if width > 0 && height > 0 => Ok(Tile { x, y, width, height }),
         _ => Err("expected X,Y,W,H with W, H > 0".into()),
@@ -180,6 +178,13 @@ fn parse_rgb(s: &str) -> Result<Vec3, String> {
 
 fn main() -> ExitCode {
     quiet_vulkan_loader();
+    // A bug must still be one line on stderr, never a backtrace in a user's face.
+    std::panic::set_hook(Box::new(|info| {
+        let msg = info.payload().downcast_ref::<&str>().map(|s| s.to_string());
+        let msg = msg.or_else(|| info.payload().downcast_ref::<String>().cloned()).unwrap_or_default();
+        let at = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
+        eprintln!("veach: internal error{at}: {msg} (please report it)");
+    }));
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render(&args),

@@ -155,7 +155,7 @@ pub fn read_film(path: &Path) -> Result<(Film, Job), crate::Error> {
             .channel_data
             .list
             .iter()
-            .find(|c| c.name == Text::from(*name))
+            .find(|c| c.name == **name)
             .ok_or_else(|| fail(format!("missing film channel {name}")))?;
         let words: Vec<u32> = match &channel.sample_data {
             FlatSamples::U32(v) => v.clone(),

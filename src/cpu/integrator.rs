@@ -135,7 +135,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
     radiance
 }
 
-/// One sample for one film pixel; returns the radiance (possibly non-finite).
+/// Sample `params.sample_index` of one film pixel; returns the radiance (possibly non-finite).
 pub fn render_sample(scene: &PackedScene, params: &Params, x: u32, y: u32) -> Vec3 {
     let pixel = UVec2::new(x + params.tile_x, y + params.tile_y);
     let mut rng = rng_init(pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);

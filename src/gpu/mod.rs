@@ -149,20 +149,20 @@ impl GpuRenderer {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        // One Params slot per dispatch of a batch, each at an aligned offset.
         let params_size = std::mem::size_of::<Params>() as u64;
-        let stride = params_size.next_multiple_of(limits.min_uniform_buffer_offset_alignment as u64);
+        let stride = params_size.next_multiple_of(limits.min_storage_buffer_offset_alignment as u64);
         let params_buf = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
             size: stride * MAX_BATCH as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
 
         let source = shaders::compose(shaders::INTEGRATOR).map_err(Error::Gpu)?;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("integrator"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
+        let descriptor =
+            wgpu::ShaderModuleDescriptor { label: Some("integrator"), source: wgpu::ShaderSource::Wgsl(source.into()) };
+        let module = device.create_shader_module(descriptor);
         let storage_entry = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -180,7 +180,7 @@ impl GpuRenderer {
                     binding: 0,
                     visibility: wgpu::ShaderStages::COMPUTE,
                     ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
                         has_dynamic_offset: true,
                         min_binding_size: wgpu::BufferSize::new(params_size),
                     },
@@ -248,8 +248,7 @@ impl GpuRenderer {
             let batch = (count - done).min(MAX_BATCH);
             let mut data = vec![0u8; (self.stride * batch as u64) as usize];
             for k in 0..batch {
-                let mut p = self.params;
-                p.sample_index = start + done + k;
+                let p = Params { sample_index: start + done + k, ..self.params };
                 let at = (self.stride * k as u64) as usize;
                 data[at..at + std::mem::size_of::<Params>()].copy_from_slice(bytemuck::bytes_of(&p));
             }
@@ -312,7 +311,7 @@ impl GpuRenderer {
 fn check_limit(what: &str, bytes: u64, limit: u64, name: &str) -> Result<(), Error> {
     if bytes > limit {
         return Err(Error::Limit(format!(
-            "the {what} buffer needs {bytes} bytes, above the device limit {name} = {limit}"
+            "the {what} buffer needs {bytes} bytes, above the device limit {name} = {limit}; render tiles (--tile)"
         )));
     }
     Ok(())

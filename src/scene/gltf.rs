@@ -7,6 +7,19 @@ use std::path::Path;
 
 /// Refuse scenes beyond this before allocating for them (hostile counts).
 pub const MAX_TRIANGLES: usize = 64 << 20;
+/// Largest glTF/GLB file or buffer accepted.
+pub const MAX_FILE_BYTES: u64 = 4 << 30;
+/// Most node visits while flattening the hierarchy (shared subtrees multiply).
+pub const MAX_NODE_VISITS: usize = 1 << 20;
+
+/// Extensions veach reads (or can safely ignore) when a file requires them.
+pub const SUPPORTED_EXTENSIONS: &[&str] =
+    &["KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_ior"];
+
+/// Extensions veach knows and ignores for now (textures, transmission, lights come later);
+/// files that merely use them render, with one warning each.
+const KNOWN_UNIMPLEMENTED: &[&str] =
+    &["KHR_texture_transform", "KHR_materials_transmission", "KHR_materials_volume", "KHR_lights_punctual"];
 
 pub fn load(path: &Path) -> Result<Scene, Error> {
     let fail = |msg: String| Error::Input(format!("{}: {msg}", path.display()));
@@ -14,7 +27,110 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
     if meta.is_dir() {
         return Err(fail("is a directory, not a glTF file".into()));
     }
-    let (doc, buffers, _images) = gltf::import(path).map_err(|e| fail(describe(&e)))?;
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(fail(format!("{} bytes: larger than the {MAX_FILE_BYTES}-byte limit", meta.len())));
+    }
+    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    load_bytes(&bytes, path.parent()).map_err(fail)
+}
+
+/// Loads a .gltf or .glb held in memory; external files resolve against `base` (none: only
+/// embedded data). Errors are the problem alone, without the file name.
+pub fn load_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
+    let json = if bytes.starts_with(b"glTF") { glb_json_chunk(bytes)? } else { bytes };
+    let raw: serde_json::Value = serde_json::from_slice(json).map_err(|e| format!("invalid glTF JSON: {e}"))?;
+    let mut warnings = Vec::new();
+    check_extensions(&raw, &mut warnings)?;
+    let gltf = contained(|| gltf::Gltf::from_slice(bytes))?.map_err(|e| describe(&e))?;
+    for buffer in gltf.document.buffers() {
+        if buffer.length() as u64 > MAX_FILE_BYTES {
+            return Err(format!("buffer {} declares {} bytes, above the limit", buffer.index(), buffer.length()));
+        }
+    }
+    let blob = gltf.blob.clone();
+    let buffers = contained(|| gltf::import_buffers(&gltf.document, base.or(Some(Path::new("."))), blob))?
+        .map_err(|e| describe(&e))?;
+    let mut scene = from_document(&gltf.document, &buffers)?;
+    scene.warnings = warnings;
+    Ok(scene)
+}
+
+thread_local! {
+    static CONTAINED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs a call into the gltf crate, turning a panic into an error. Its validator indexes
+/// arrays with unchecked indices from the file (gltf-json 1.4.1, mesh.rs:151), so a hostile
+/// file can make it panic; while contained, the panic prints nothing.
+fn contained<T>(f: impl FnOnce() -> T) -> Result<T, String> {
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !CONTAINED.with(|c| c.get()) {
+                previous(info);
+            }
+        }));
+    });
+    CONTAINED.with(|c| c.set(true));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+    CONTAINED.with(|c| c.set(false));
+    result.map_err(|_| "invalid glTF: an index or reference is out of range".to_string())
+}
+
+/// The JSON chunk of a GLB, after checking the container's header and chunk bounds.
+fn glb_json_chunk(bytes: &[u8]) -> Result<&[u8], String> {
+    let word = |at: usize| -> Result<u32, String> {
+        bytes
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or_else(|| "truncated GLB".to_string())
+    };
+    let (version, length) = (word(4)?, word(8)? as usize);
+    if version != 2 {
+        return Err(format!("GLB version {version} (only 2 is glTF 2.0)"));
+    }
+    if length < 20 || length > bytes.len() {
+        return Err(format!("GLB header says {length} bytes, the file has {}", bytes.len()));
+    }
+    let (chunk_len, chunk_type) = (word(12)? as usize, word(16)?);
+    if chunk_type != 0x4E4F534A {
+        return Err("GLB's first chunk is not JSON".into());
+    }
+    let end = 20usize.checked_add(chunk_len).filter(|&e| e <= length).ok_or("GLB JSON chunk runs past the file")?;
+    if end + 8 <= length {
+        let bin_len = word(end)? as usize;
+        if end.checked_add(8).and_then(|s| s.checked_add(bin_len)).is_none_or(|e| e > length) {
+            return Err("GLB BIN chunk runs past the file".into());
+        }
+    }
+    Ok(&bytes[20..end])
+}
+
+/// Required extensions veach cannot honour are an error naming them; used ones it does not
+/// know get one warning each.
+fn check_extensions(raw: &serde_json::Value, warnings: &mut Vec<String>) -> Result<(), String> {
+    let list = |key: &str| -> Vec<String> {
+        raw.get(key)
+            .and_then(|v| v.as_array())
+            .map(|a| a.iter().filter_map(|x| x.as_str().map(str::to_string)).collect())
+            .unwrap_or_default()
+    };
+    let missing: Vec<String> =
+        list("extensionsRequired").into_iter().filter(|e| !SUPPORTED_EXTENSIONS.contains(&e.as_str())).collect();
+    if !missing.is_empty() {
+        return Err(format!("requires glTF extensions veach does not support: {}", missing.join(", ")));
+    }
+    for e in list("extensionsUsed") {
+        if !SUPPORTED_EXTENSIONS.contains(&e.as_str()) {
+            let what = if KNOWN_UNIMPLEMENTED.contains(&e.as_str()) { "not implemented yet" } else { "unknown" };
+            warnings.push(format!("extension {e} is {what}; ignoring it"));
+        }
+    }
+    Ok(())
+}
+
+fn from_document(doc: &gltf::Document, buffers: &[gltf::buffer::Data]) -> Result<Scene, String> {
     let mut scene = Scene::default();
 
     for m in doc.materials() {
@@ -26,21 +142,26 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
 
     let gltf_scene = doc.default_scene().or_else(|| doc.scenes().next());
     let Some(gltf_scene) = gltf_scene else {
-        return Err(fail("the file has no scene".into()));
+        return Err("the file has no scene".into());
     };
     if let Some(env) = environment_from_extras(gltf_scene.extras()) {
         scene.environment = env;
     }
 
     let mut stack: Vec<(gltf::Node, Mat4, usize)> = gltf_scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    let mut visits = 0usize;
     while let Some((node, parent, depth)) = stack.pop() {
+        visits += 1;
+        if visits > MAX_NODE_VISITS {
+            return Err(format!("the node hierarchy expands to more than {MAX_NODE_VISITS} nodes"));
+        }
         if depth > 256 {
-            return Err(fail("node hierarchy deeper than 256 levels (a cycle?)".into()));
+            return Err("node hierarchy deeper than 256 levels (a cycle?)".into());
         }
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         let world = parent * local;
         if !world.is_finite() {
-            return Err(fail(format!("node {} has a non-finite transform", node.index())));
+            return Err(format!("node {} has a non-finite transform", node.index()));
         }
         if let Some(cam) = node.camera()
             && let gltf::camera::Projection::Perspective(p) = cam.projection()
@@ -53,15 +174,14 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
             scene.cameras.push(Camera::from_matrix(name, world, p.yfov()));
         }
         if let Some(mesh) = node.mesh() {
-            load_mesh(&mesh, world, &buffers, default_material, &mut scene).map_err(fail)?;
+            load_mesh(&mesh, world, buffers, default_material, &mut scene)?;
         }
         for child in node.children() {
             stack.push((child, world, depth + 1));
         }
     }
     // Depth-first order above reversed the cameras; keep the file's order for "first camera".
-    scene.cameras.sort_by_key(|c| c.name.clone());
-    let order = camera_order(&doc);
+    let order = camera_order(doc);
     scene.cameras.sort_by_key(|c| order.iter().position(|n| n == &c.name).unwrap_or(usize::MAX));
     Ok(scene)
 }
@@ -138,6 +258,19 @@ fn load_mesh(
         if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
             continue; // points and lines have no area to render
         }
+        let name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
+        // Check every accessor we read against its buffer before the reader touches it.
+        let attrs = [
+            ("POSITION", prim.get(&gltf::Semantic::Positions), gltf::accessor::Dimensions::Vec3),
+            ("NORMAL", prim.get(&gltf::Semantic::Normals), gltf::accessor::Dimensions::Vec3),
+            ("indices", prim.indices(), gltf::accessor::Dimensions::Scalar),
+        ];
+        for (what, accessor, dims) in attrs {
+            if let Some(a) = accessor {
+                check_accessor(&a, Some(dims), buffers)
+                    .map_err(|e| format!("{name}: {what} accessor {}: {e}", a.index()))?;
+            }
+        }
         let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
         let Some(positions) = reader.read_positions() else {
             continue;
@@ -153,7 +286,6 @@ fn load_mesh(
             return Err(format!("more than {MAX_TRIANGLES} triangles"));
         }
         let material = prim.material().index().map_or(default_material, |i| i as u32);
-        let name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
         for [a, b, c] in tris {
             let mut idx = [a, b, c];
             if mirrored {
@@ -176,6 +308,53 @@ fn load_mesh(
             };
             scene.triangles.push(Triangle { positions: p, normals: n, material });
         }
+    }
+    Ok(())
+}
+
+/// An accessor's bytes lie inside its view, and its view inside its buffer; its type is one
+/// veach reads.
+fn check_accessor(
+    a: &gltf::Accessor,
+    dims: Option<gltf::accessor::Dimensions>,
+    buffers: &[gltf::buffer::Data],
+) -> Result<(), String> {
+    use gltf::accessor::{DataType, Dimensions};
+    if a.sparse().is_some() {
+        return Err("sparse accessors are not supported".into());
+    }
+    if let Some(d) = dims
+        && a.dimensions() != d
+    {
+        return Err(format!("is {:?}, expected {:?}", a.dimensions(), d));
+    }
+    let ok_type = match a.dimensions() {
+        Dimensions::Scalar => matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32),
+        _ => a.data_type() == DataType::F32,
+    };
+    if !ok_type {
+        return Err(format!("component type {:?} is not supported here", a.data_type()));
+    }
+    let view = a.view().ok_or("has no buffer view")?;
+    let buffer = buffers.get(view.buffer().index()).ok_or("its buffer is missing")?;
+    let view_end = (view.offset() as u64).checked_add(view.length() as u64).ok_or("view overflows")?;
+    if view_end > buffer.0.len() as u64 {
+        return Err(format!("its view ends at byte {view_end}, past the buffer's {} bytes", buffer.0.len()));
+    }
+    let elem = a.size() as u64;
+    let stride = view.stride().map_or(elem, |s| s as u64);
+    if stride < elem {
+        return Err(format!("byte stride {stride} is smaller than an element ({elem} bytes)"));
+    }
+    if a.count() == 0 {
+        return Ok(());
+    }
+    let need = (a.offset() as u64)
+        .checked_add(stride.checked_mul(a.count() as u64 - 1).ok_or("count overflows")?)
+        .and_then(|x| x.checked_add(elem))
+        .ok_or("count overflows")?;
+    if need > view.length() as u64 {
+        return Err(format!("{} elements need {need} bytes, its view has {}", a.count(), view.length()));
     }
     Ok(())
 }

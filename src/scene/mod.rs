@@ -101,6 +101,8 @@ pub struct Scene {
     /// scale of `environment_map` when there is one.
     pub environment: Vec3,
     pub environment_map: Option<EnvironmentMap>,
+    /// Things the loader ignored, one line each (unknown optional extensions, ...).
+    pub warnings: Vec<String>,
 }
 
 impl Scene {

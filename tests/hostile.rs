@@ -1,0 +1,222 @@
+//! Hostile and broken glTF: every input gives a scene or one clear error, never a panic, and
+//! nothing is allocated for counts the file cannot back.
+
+mod common;
+
+use glam::Vec3;
+use serde_json::{Value, json};
+use veach::scene::gltf::load_bytes;
+
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 >> 33
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+fn base64(bytes: &[u8]) -> String {
+    const T: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            if k <= c.len() {
+                out.push(T[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+/// A one-mesh glTF built from raw positions and indices, for targeted breakage.
+fn triangle_gltf(positions: &[f32], indices: &[u32], count_override: Option<u64>) -> Vec<u8> {
+    let mut bin: Vec<u8> = positions.iter().flat_map(|f| f.to_le_bytes()).collect();
+    let pos_len = bin.len();
+    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+        "materials": [{"emissiveFactor": [1.0, 1.0, 1.0]}],
+        "buffers": [{"byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(&bin))}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": pos_len},
+            {"buffer": 0, "byteOffset": pos_len, "byteLength": bin.len() - pos_len}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": count_override.unwrap_or((positions.len() / 3) as u64),
+             "type": "VEC3", "min": [-1e38, -1e38, -1e38], "max": [1e38, 1e38, 1e38]},
+            {"bufferView": 1, "componentType": 5125, "count": indices.len(), "type": "SCALAR"}
+        ]
+    });
+    serde_json::to_vec(&doc).unwrap()
+}
+
+fn glb(json: &[u8]) -> Vec<u8> {
+    let mut chunk = json.to_vec();
+    while chunk.len() % 4 != 0 {
+        chunk.push(b' ');
+    }
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend(((20 + chunk.len()) as u32).to_le_bytes());
+    out.extend((chunk.len() as u32).to_le_bytes());
+    out.extend(0x4E4F534Au32.to_le_bytes());
+    out.extend(chunk);
+    out
+}
+
+fn expect_error(bytes: &[u8], needle: &str) {
+    match load_bytes(bytes, None) {
+        Ok(_) => panic!("expected an error containing '{needle}'"),
+        Err(e) => assert!(e.contains(needle), "'{e}' should mention '{needle}'"),
+    }
+}
+
+#[test]
+fn targeted_breakage_gives_clear_errors() {
+    let ok = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let scene = load_bytes(&triangle_gltf(&ok, &[0, 1, 2], None), None).expect("valid triangle");
+    assert_eq!(scene.triangles.len(), 1);
+    expect_error(&triangle_gltf(&ok, &[0, 1, 7], None), "out of range");
+    expect_error(&triangle_gltf(&[f32::NAN, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], &[0, 1, 2], None), "non-finite");
+    expect_error(&triangle_gltf(&ok, &[0, 1, 2], Some(4_000_000_000)), "elements need");
+    expect_error(&triangle_gltf(&ok, &[0, 1, 2], Some(5)), "elements need");
+    expect_error(b"{\"asset\": {\"version\": \"2.0\"", "invalid glTF JSON");
+    expect_error(b"glTF\x02\x00\x00\x00\xff\xff\xff\x7f", "GLB");
+    expect_error(&glb(b"{}")[..18], "GLB");
+    let mut draco: Value = serde_json::from_slice(&triangle_gltf(&ok, &[0, 1, 2], None)).unwrap();
+    draco["extensionsUsed"] = json!(["KHR_draco_mesh_compression", "EXT_meshopt_compression"]);
+    draco["extensionsRequired"] = json!(["KHR_draco_mesh_compression", "EXT_meshopt_compression"]);
+    expect_error(&serde_json::to_vec(&draco).unwrap(), "KHR_draco_mesh_compression, EXT_meshopt_compression");
+    // Optional unknown extensions are ignored with one warning each.
+    draco.as_object_mut().unwrap().remove("extensionsRequired");
+    let scene = load_bytes(&serde_json::to_vec(&draco).unwrap(), None).expect("optional extensions load");
+    assert_eq!(scene.warnings.len(), 2, "{:?}", scene.warnings);
+}
+
+#[test]
+fn degenerate_empty_and_huge_scenes_render_finite_images() {
+    // Zero-area emissive triangles are never lights; a huge one still renders.
+    let zero = [0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 2.0, 2.0, 2.0];
+    let scene = load_bytes(&triangle_gltf(&zero, &[0, 1, 2], None), None).expect("degenerate triangle loads");
+    assert_eq!(veach::packed::PackedScene::new(&scene).lights.len(), 0);
+    let huge = [-1e30, -1e30, 0.0, 1e30, -1e30, 0.0, 0.0, 1e30, 0.0];
+    for bytes in [triangle_gltf(&huge, &[0, 1, 2], None), triangle_gltf(&zero, &[0, 1, 2], None)] {
+        let mut scene = load_bytes(&bytes, None).expect("loads");
+        scene.environment = Vec3::splat(0.5);
+        let camera = scene.camera(None).expect("camera");
+        let packed = veach::packed::PackedScene::new(&scene);
+        let mut r = veach::Renderer::new(packed, &camera, &common::settings(16, 8, 0), veach::Backend::Cpu).unwrap();
+        r.render_samples(0, 4).unwrap();
+        let film = r.film().unwrap();
+        assert!((0..film.pixel_count()).all(|i| film.mean(i).is_finite()));
+    }
+    let empty = json!({"asset": {"version": "2.0"}, "scenes": [{"nodes": []}], "scene": 0});
+    let scene = load_bytes(&serde_json::to_vec(&empty).unwrap(), None).expect("an empty scene loads");
+    assert!(scene.triangles.is_empty());
+}
+
+/// Every numeric leaf of a JSON document, as a path of keys and indices.
+fn numeric_paths(v: &Value, path: &mut Vec<Value>, out: &mut Vec<Vec<Value>>) {
+    match v {
+        Value::Number(_) => out.push(path.clone()),
+        Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                path.push(json!(i));
+                numeric_paths(x, path, out);
+                path.pop();
+            }
+        }
+        Value::Object(o) => {
+            for (k, x) in o {
+                path.push(json!(k));
+                numeric_paths(x, path, out);
+                path.pop();
+            }
+        }
+        _ => {}
+    }
+}
+
+fn at<'a>(v: &'a mut Value, path: &[Value]) -> &'a mut Value {
+    path.iter().fold(v, |v, k| match k {
+        Value::String(s) => &mut v[s.as_str()],
+        Value::Number(n) => &mut v[n.as_u64().unwrap() as usize],
+        _ => unreachable!(),
+    })
+}
+
+#[test]
+fn mutated_assets_never_panic() {
+    let mut rng = Lcg(12345);
+    let originals: Vec<Vec<u8>> = ["cornell-box.gltf", "veach-mis.gltf"]
+        .iter()
+        .map(|n| std::fs::read(common::asset(n)).expect("asset"))
+        .chain([triangle_gltf(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], &[0, 1, 2], None)])
+        .collect();
+    let hostile =
+        [json!(-1), json!(0), json!(1), json!(3), json!(65535), json!(4294967295u64), json!(1e20), json!(0.5)];
+    let (mut loaded, mut refused, mut inputs) = (0, 0, 0);
+    let start = std::time::Instant::now();
+    for round in 0..3000 {
+        let base = &originals[round % originals.len()];
+        let bytes = match round % 3 {
+            // Structured: a few numbers (indices, counts, offsets, strides, types) made hostile.
+            0 | 1 => {
+                let mut doc: Value = serde_json::from_slice(base).unwrap();
+                let mut paths = Vec::new();
+                numeric_paths(&doc, &mut Vec::new(), &mut paths);
+                for _ in 0..1 + rng.below(3) {
+                    let p = &paths[rng.below(paths.len())];
+                    *at(&mut doc, p) = hostile[rng.below(hostile.len())].clone();
+                }
+                let bytes = serde_json::to_vec(&doc).unwrap();
+                if round % 6 == 1 { glb(&bytes) } else { bytes }
+            }
+            // Bytes: flips, truncation, duplication (of the JSON or of a GLB around it).
+            _ => {
+                let mut b = if rng.below(2) == 0 { glb(base) } else { base.clone() };
+                match rng.below(3) {
+                    0 => {
+                        for _ in 0..1 + rng.below(8) {
+                            let i = rng.below(b.len());
+                            b[i] ^= 1 << rng.below(8);
+                        }
+                    }
+                    1 => b.truncate(rng.below(b.len())),
+                    _ => {
+                        let i = rng.below(b.len());
+                        let chunk = b[i..(i + rng.below(64)).min(b.len())].to_vec();
+                        let j = rng.below(b.len());
+                        b.splice(j..j, chunk);
+                    }
+                }
+                b
+            }
+        };
+        inputs += 1;
+        let result = std::panic::catch_unwind(|| load_bytes(&bytes, None).map(|s| s.triangles.len()));
+        match result {
+            Ok(Ok(_)) => loaded += 1,
+            Ok(Err(e)) => {
+                assert!(!e.is_empty() && !e.contains('\n'), "one line: {e}");
+                refused += 1;
+            }
+            Err(_) => {
+                let _ = std::fs::write(std::env::temp_dir().join("veach-panic-input.gltf"), &bytes);
+                panic!("input {round} panicked (saved to veach-panic-input.gltf in the temp dir)");
+            }
+        }
+    }
+    eprintln!("{inputs} mutated inputs: {loaded} loaded, {refused} refused, {:.1} s", start.elapsed().as_secs_f64());
+    assert!(loaded > 100 && refused > 100, "the mutations exercise both outcomes");
+}
