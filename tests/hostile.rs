@@ -62,7 +62,7 @@ fn triangle_gltf(positions: &[f32], indices: &[u32], count_override: Option<u64>
 
 fn glb(json: &[u8]) -> Vec<u8> {
     let mut chunk = json.to_vec();
-    while chunk.len() % 4 != 0 {
+    while !chunk.len().is_multiple_of(4) {
         chunk.push(b' ');
     }
     let mut out = b"glTF".to_vec();
