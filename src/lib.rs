@@ -13,6 +13,8 @@ pub mod output;
 pub mod packed;
 pub mod params;
 pub mod scene;
+pub mod tonemap;
+pub mod viewer;
 
 use film::Film;
 use glam::Vec3;
@@ -283,6 +285,33 @@ impl Renderer {
         match &self.engine {
             Engine::Gpu(g) => g.read_film(),
             Engine::Cpu(film) => Ok(film.clone()),
+        }
+    }
+
+    /// Restarts accumulation with a new camera and settings (same scene): the viewer's reset.
+    pub fn reset(&mut self, camera: &scene::Camera, settings: &Settings) -> Result<(), Error> {
+        let (w, h) = (settings.width, settings.height);
+        if w == 0 || h == 0 || w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE {
+            return Err(Error::Limit(format!("image size {w}x{h} is outside 1..={MAX_IMAGE_SIDE} per side")));
+        }
+        let tile = settings.tile.unwrap_or(Tile { x: 0, y: 0, width: w, height: h });
+        let env = settings.environment.unwrap_or(self.scene.environment);
+        self.params =
+            Params::new(camera, (w, h), tile, settings.seed, settings.max_depth, settings.strategy, env, &self.scene);
+        match &mut self.engine {
+            Engine::Gpu(g) => g.reset(self.params),
+            Engine::Cpu(f) => {
+                *f = Film::new(tile.width, tile.height);
+                Ok(())
+            }
+        }
+    }
+
+    /// The GPU engine, when rendering there (the viewer displays its film in place).
+    pub fn gpu(&self) -> Option<&gpu::GpuRenderer> {
+        match &self.engine {
+            Engine::Gpu(g) => Some(g),
+            Engine::Cpu(_) => None,
         }
     }
 

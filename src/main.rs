@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 use veach::film::Film;
+use veach::tonemap::Tonemap;
 use veach::{Backend, Error, Job, Renderer, Settings, Strategy, Tile};
 
 #[derive(Parser)]
@@ -24,12 +25,48 @@ struct Cli {
 enum Command {
     /// Render a glTF 2.0 scene (.gltf/.glb) to a PNG (tone-mapped) or EXR (linear).
     Render(RenderArgs),
+    /// Open the interactive preview window (egui), refining progressively on the GPU.
+    View(ViewArgs),
     /// Merge renders of disjoint sample ranges or tiles (EXRs written by veach) into one image.
     Merge(MergeArgs),
     /// Render the seed's four direct-lighting estimators at equal spp, side by side with labels.
     Strategies(StrategiesArgs),
     /// List the Vulkan adapters and their limits.
     Info,
+}
+
+#[derive(clap::Args)]
+struct ViewArgs {
+    /// The scene, a .gltf or .glb file (or open one from the window).
+    scene: Option<PathBuf>,
+    /// Render --frames frames, save a screenshot of the whole window here (.png), and exit.
+    #[arg(long)]
+    screenshot: Option<PathBuf>,
+    #[arg(long, default_value_t = 30)]
+    frames: u32,
+    #[arg(long, default_value_t = 8)]
+    max_depth: u32,
+    #[arg(long)]
+    env: Option<PathBuf>,
+    #[arg(long, value_parser = parse_rgb)]
+    env_color: Option<Vec3>,
+    /// Window size WxH in points.
+    #[arg(long, value_parser = parse_size, default_value = "1100x720")]
+    window: (u32, u32),
+    /// Fraction of the image area's resolution rendered (lavapipe renders 1 spp of a full
+    /// window in about 2 s; 0.5 keeps the window responsive).
+    #[arg(long, default_value_t = 0.5)]
+    render_scale: f32,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once('x').ok_or("expected WxH, e.g. 1100x720")?;
+    let w: u32 = w.parse().map_err(|e| format!("'{w}': {e}"))?;
+    let h: u32 = h.parse().map_err(|e| format!("'{h}': {e}"))?;
+    if !(64..=16384).contains(&w) || !(64..=16384).contains(&h) {
+        return Err("window sides must be 64..=16384".into());
+    }
+    Ok((w, h))
 }
 
 #[derive(clap::Args)]
@@ -67,6 +104,8 @@ struct StrategiesArgs {
     seed: u32,
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     exposure: f32,
+    #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
+    tonemap: Tonemap,
     #[arg(long, value_enum)]
     backend: Option<Backend>,
     #[arg(long)]
@@ -105,9 +144,12 @@ struct RenderArgs {
     /// Seed of the random sequences; the same seed renders the same image.
     #[arg(long, default_value_t = 0)]
     seed: u32,
-    /// Exposure in stops applied before the PNG is clamped (EXR stays linear).
+    /// Exposure in stops applied before the PNG is tone-mapped (EXR stays linear).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     exposure: f32,
+    /// Tone mapper of PNG output.
+    #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
+    tonemap: Tonemap,
     /// Direct-lighting estimator.
     #[arg(long, value_enum, default_value_t = Strategy::MisPower)]
     strategy: Strategy,
@@ -189,6 +231,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render(&args),
         Command::Merge(args) => merge(&args),
+        Command::View(args) => view(args).map(|_| Outcome::Done),
         Command::Strategies(args) => strategies(&args).map(|_| Outcome::Done),
         Command::Info => info().map(|_| Outcome::Done),
     };
@@ -343,7 +386,7 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
     let film = renderer.film()?;
     let seconds_render = t_render.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    veach::output::write(&film, &args.output, args.exposure, Some(&job))?;
+    veach::output::write_with(&film, &args.output, args.exposure, args.tonemap, Some(&job))?;
     if let Some(path) = &args.checkpoint {
         veach::output::write(&film, path, 0.0, Some(&job))?;
     }
@@ -399,6 +442,24 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
 enum Outcome {
     Done,
     Interrupted,
+}
+
+fn view(args: ViewArgs) -> Result<(), Error> {
+    if let Some(shot) = &args.screenshot
+        && veach::output::check_output(shot)? != veach::output::Format::Png
+    {
+        return Err(Error::Input(format!("{}: screenshots are .png", shot.display())));
+    }
+    veach::viewer::run(veach::viewer::ViewOptions {
+        scene: args.scene,
+        screenshot: args.screenshot,
+        frames: args.frames,
+        max_depth: args.max_depth,
+        env: args.env,
+        env_color: args.env_color,
+        window: args.window,
+        render_scale: args.render_scale,
+    })
 }
 
 fn merge(args: &MergeArgs) -> Result<Outcome, Error> {
@@ -522,7 +583,7 @@ fn strategies(args: &StrategiesArgs) -> Result<(), Error> {
         renderer.render_samples(0, args.spp)?;
         let film = renderer.film()?;
         eprintln!("veach: {strategy:?}: {} spp in {:.2} s", args.spp, t.elapsed().as_secs_f64());
-        let panel = veach::output::tonemap(&film, args.exposure);
+        let panel = veach::output::tonemap(&film, args.exposure, args.tonemap);
         image::imageops::replace(&mut sheet, &panel, (k as u32 * w) as i64, bar as i64);
         let name = match strategy {
             Strategy::Bsdf => "BSDF",

@@ -2,6 +2,7 @@
 //! temporary file renamed into place so a reader never sees a partial image.
 
 use crate::film::{Film, WORDS_PER_PIXEL};
+use crate::tonemap::Tonemap;
 use crate::{Error, Job};
 use std::path::{Path, PathBuf};
 
@@ -39,19 +40,14 @@ fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
-/// Linear radiance → 8-bit sRGB, after scaling by 2^exposure and clamping.
-pub fn to_srgb8(linear: f32, exposure: f32) -> u8 {
-    let v = (linear * exposure.exp2()).clamp(0.0, 1.0);
-    let s = if v <= 0.0031308 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
-    (s * 255.0 + 0.5) as u8
-}
-
-/// The film's mean, exposed, clamped and sRGB-encoded.
-pub fn tonemap(film: &Film, exposure: f32) -> image::RgbImage {
+/// The film's mean, exposed, tone-mapped and sRGB-encoded.
+pub fn tonemap(film: &Film, exposure: f32, operator: Tonemap) -> image::RgbImage {
     let mut img = image::RgbImage::new(film.width, film.height);
+    let scale = exposure.exp2();
     for (i, px) in img.pixels_mut().enumerate() {
-        let m = film.mean(i);
-        *px = image::Rgb([to_srgb8(m.x, exposure), to_srgb8(m.y, exposure), to_srgb8(m.z, exposure)]);
+        let c = crate::tonemap::tonemap(film.mean(i) * scale, operator);
+        let q = |v: f32| (crate::tonemap::srgb_encode(v) * 255.0 + 0.5) as u8;
+        *px = image::Rgb([q(c.x), q(c.y), q(c.z)]);
     }
     img
 }
@@ -59,8 +55,12 @@ pub fn tonemap(film: &Film, exposure: f32) -> image::RgbImage {
 /// Writes the film's image: a tone-mapped PNG, or a linear EXR that also carries the film
 /// (sums, counts) and the job, so it can be resumed or merged with other parts.
 pub fn write(film: &Film, path: &Path, exposure: f32, job: Option<&Job>) -> Result<(), Error> {
+    write_with(film, path, exposure, Tonemap::Clamp, job)
+}
+
+pub fn write_with(film: &Film, path: &Path, exposure: f32, operator: Tonemap, job: Option<&Job>) -> Result<(), Error> {
     match check_output(path)? {
-        Format::Png => write_png(&tonemap(film, exposure), path),
+        Format::Png => write_png(&tonemap(film, exposure, operator), path),
         Format::Exr => write_exr(film, path, job),
     }
 }

@@ -38,6 +38,18 @@ pub struct GpuContext {
 }
 
 impl GpuContext {
+    /// Wraps a device opened elsewhere (the viewer's window), capturing its errors.
+    pub fn from_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> GpuContext {
+        let errors = Arc::new(Mutex::new(None));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut slot) = sink.lock() {
+                slot.get_or_insert_with(|| e.to_string());
+            }
+        }));
+        GpuContext { device, queue, info, errors }
+    }
+
     pub fn new() -> Result<GpuContext, Error> {
         let inst = instance();
         // WGPU_ADAPTER_NAME picks an adapter by name; an unmatched name is our error, not a panic.
@@ -77,7 +89,7 @@ impl GpuContext {
         Ok(GpuContext { device, queue, info, errors })
     }
 
-    fn check(&self) -> Result<(), Error> {
+    pub fn check(&self) -> Result<(), Error> {
         match self.errors.lock().ok().and_then(|mut e| e.take()) {
             Some(msg) => Err(Error::Gpu(msg)),
             None => Ok(()),
@@ -95,6 +107,8 @@ pub const MAX_BATCH: u32 = 64;
 pub struct GpuRenderer {
     ctx: GpuContext,
     pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    scene: [wgpu::Buffer; 6],
     bind_group: wgpu::BindGroup,
     params_buf: wgpu::Buffer,
     film_buf: wgpu::Buffer,
@@ -109,9 +123,6 @@ impl GpuRenderer {
     pub fn new(ctx: GpuContext, scene: &PackedScene, params: Params) -> Result<GpuRenderer, Error> {
         let device = &ctx.device;
         let limits = device.limits();
-        let pixels = params.film_width as u64 * params.film_height as u64;
-        let film_bytes = pixels * (WORDS_PER_PIXEL * 4) as u64;
-
         let storage = |label: &str, bytes: &[u8]| -> Result<wgpu::Buffer, Error> {
             let len = bytes.len() as u64;
             check_limit(label, len, limits.max_storage_buffer_binding_size, "max_storage_buffer_binding_size")?;
@@ -130,25 +141,14 @@ impl GpuRenderer {
                 usage: wgpu::BufferUsages::STORAGE,
             }))
         };
-        let nodes = storage("bvh nodes", bytemuck::cast_slice(&scene.nodes))?;
-        let triangles = storage("triangles", bytemuck::cast_slice(&scene.triangles))?;
-        let normals = storage("normals", bytemuck::cast_slice(&scene.normals))?;
-        let materials = storage("materials", bytemuck::cast_slice(&scene.materials))?;
-        let lights = storage("lights", bytemuck::cast_slice(&scene.lights))?;
-        let env = storage("environment", bytemuck::cast_slice(&scene.env))?;
-        check_limit("film", film_bytes, limits.max_storage_buffer_binding_size, "max_storage_buffer_binding_size")?;
-        let film_buf = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("film"),
-            size: film_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("film readback"),
-            size: film_bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let scene_buffers = [
+            storage("bvh nodes", bytemuck::cast_slice(&scene.nodes))?,
+            storage("triangles", bytemuck::cast_slice(&scene.triangles))?,
+            storage("normals", bytemuck::cast_slice(&scene.normals))?,
+            storage("materials", bytemuck::cast_slice(&scene.materials))?,
+            storage("lights", bytemuck::cast_slice(&scene.lights))?,
+            storage("environment", bytemuck::cast_slice(&scene.env))?,
+        ];
         // One Params slot per dispatch of a batch, each at an aligned offset.
         let params_size = std::mem::size_of::<Params>() as u64;
         let stride = params_size.next_multiple_of(limits.min_storage_buffer_offset_alignment as u64);
@@ -195,27 +195,6 @@ impl GpuRenderer {
                 storage_entry(7, true),
             ],
         });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params_buf,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(params_size),
-                    }),
-                },
-                wgpu::BindGroupEntry { binding: 1, resource: nodes.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: triangles.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: normals.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: materials.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: lights.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 6, resource: film_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 7, resource: env.as_entire_binding() },
-            ],
-        });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("integrator"),
             bind_group_layouts: &[Some(&layout)],
@@ -229,12 +208,95 @@ impl GpuRenderer {
             compilation_options: Default::default(),
             cache: None,
         });
-        let gpu_bytes = [&nodes, &triangles, &normals, &materials, &lights, &env, &film_buf, &params_buf]
-            .iter()
-            .map(|b| b.size())
-            .sum::<u64>();
+        let (film_buf, readback, bind_group) = Self::film(&ctx, &layout, &scene_buffers, &params_buf, params)?;
+        let gpu_bytes = scene_buffers.iter().chain([&film_buf, &params_buf]).map(|b| b.size()).sum::<u64>();
         ctx.check()?;
-        Ok(GpuRenderer { ctx, pipeline, bind_group, params_buf, film_buf, readback, stride, params, gpu_bytes })
+        Ok(GpuRenderer {
+            ctx,
+            pipeline,
+            layout,
+            scene: scene_buffers,
+            bind_group,
+            params_buf,
+            film_buf,
+            readback,
+            stride,
+            params,
+            gpu_bytes,
+        })
+    }
+
+    /// A zeroed film for `params`' window, its readback buffer and the bind group using it.
+    fn film(
+        ctx: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+        scene: &[wgpu::Buffer; 6],
+        params_buf: &wgpu::Buffer,
+        params: Params,
+    ) -> Result<(wgpu::Buffer, wgpu::Buffer, wgpu::BindGroup), Error> {
+        let device = &ctx.device;
+        let limits = device.limits();
+        let pixels = params.film_width as u64 * params.film_height as u64;
+        let film_bytes = pixels * (WORDS_PER_PIXEL * 4) as u64;
+        check_limit("film", film_bytes, limits.max_storage_buffer_binding_size, "max_storage_buffer_binding_size")?;
+        let film_buf = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("film"),
+            size: film_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("film readback"),
+            size: film_bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let params_size = std::mem::size_of::<Params>() as u64;
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: params_buf,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(params_size),
+                    }),
+                },
+                entry(1, &scene[0]),
+                entry(2, &scene[1]),
+                entry(3, &scene[2]),
+                entry(4, &scene[3]),
+                entry(5, &scene[4]),
+                entry(6, &film_buf),
+                entry(7, &scene[5]),
+            ],
+        });
+        Ok((film_buf, readback, bind_group))
+    }
+
+    /// New parameters (camera, settings, window) and an empty film: the viewer's restart.
+    pub fn reset(&mut self, params: Params) -> Result<(), Error> {
+        if (params.film_width, params.film_height) != (self.params.film_width, self.params.film_height) {
+            let (film, readback, bind_group) =
+                Self::film(&self.ctx, &self.layout, &self.scene, &self.params_buf, params)?;
+            (self.film_buf, self.readback, self.bind_group) = (film, readback, bind_group);
+        } else {
+            let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+            encoder.clear_buffer(&self.film_buf, 0, None);
+            self.ctx.queue.submit([encoder.finish()]);
+        }
+        self.params = params;
+        self.ctx.check()
+    }
+
+    pub fn film_buffer(&self) -> &wgpu::Buffer {
+        &self.film_buf
+    }
+
+    pub fn context(&self) -> &GpuContext {
+        &self.ctx
     }
 
     pub fn adapter_name(&self) -> String {
@@ -306,6 +368,10 @@ impl GpuRenderer {
         self.readback.unmap();
         Ok(film)
     }
+}
+
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
 }
 
 fn check_limit(what: &str, bytes: u64, limit: u64, name: &str) -> Result<(), Error> {

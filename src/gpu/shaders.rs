@@ -17,10 +17,13 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
     ("film.wgsl", include_str!("../../shaders/film.wgsl")),
     ("integrator.wgsl", include_str!("../../shaders/integrator.wgsl")),
+    ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
+    ("display.wgsl", include_str!("../../shaders/display.wgsl")),
 ];
 
-/// The kernel's entry file.
+/// The kernels' entry files.
 pub const INTEGRATOR: &str = "integrator.wgsl";
+pub const DISPLAY: &str = "display.wgsl";
 
 /// Composes `entry` and everything it includes into one WGSL source.
 pub fn compose(entry: &str) -> Result<String, String> {

@@ -1,0 +1,30 @@
+// The viewer's resolve pass: film mean × 2^exposure → tone map → sRGB, into the texture
+// egui shows (no readback to the CPU). The film layout is film.wgsl's.
+#include "tonemap.wgsl"
+
+struct DisplayParams {
+    width: u32,
+    height: u32,
+    tonemap: u32,
+    scale: f32, // 2^exposure
+}
+
+@group(0) @binding(0) var<storage, read> display: DisplayParams;
+@group(0) @binding(1) var<storage, read> film: array<vec4<u32>>;
+@group(0) @binding(2) var output: texture_storage_2d<rgba8unorm, write>;
+
+@compute @workgroup_size(8, 8, 1)
+fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= display.width || gid.y >= display.height) {
+        return;
+    }
+    let base = 3u * (gid.y * display.width + gid.x);
+    let hi = film[base];
+    let lo = film[base + 1u];
+    var mean = vec3<f32>(0.0);
+    if (hi.w > 0u) {
+        mean = (vec3<f32>(hi.xyz) + vec3<f32>(lo.xyz) * (1.0 / 4294967296.0)) / f32(hi.w);
+    }
+    let c = srgb_encode(tonemap(mean * display.scale, display.tonemap));
+    textureStore(output, vec2<i32>(gid.xy), vec4<f32>(c, 1.0));
+}

@@ -1,0 +1,50 @@
+//! `veach view` as a user meets it: under Xvfb with lavapipe it opens the Cornell box, renders
+//! some frames and saves a screenshot of the whole window, with the render (red wall left,
+//! green wall right) beside the settings panel.
+
+use std::process::Command;
+
+mod common;
+
+#[test]
+fn viewer_screenshot_shows_the_render_and_the_panel() {
+    let has_xvfb = Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
+    let required = std::env::var("VEACH_REQUIRE_GPU").as_deref() == Ok("1");
+    if !has_xvfb || common::gpu("viewer_screenshot").is_none() {
+        assert!(!required, "VEACH_REQUIRE_GPU=1 but xvfb-run or the GPU is missing");
+        eprintln!("skipping viewer_screenshot: needs xvfb-run (apt-get install xvfb xauth) and a Vulkan adapter");
+        return;
+    }
+    let out = std::env::temp_dir().join(format!("veach-view-{}.png", std::process::id()));
+    let scene = common::asset("cornell-box.gltf");
+    let status = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24", env!("CARGO_BIN_EXE_veach"), "view"])
+        .arg(&scene)
+        .args(["--screenshot", out.to_str().unwrap(), "--frames", "8", "--window", "640x400", "--render-scale", "0.4"])
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .expect("run xvfb-run");
+    assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
+    let img = image::open(&out).expect("a screenshot").to_rgb8();
+    let _ = std::fs::remove_file(&out);
+    assert!(img.width() >= 600 && img.height() >= 380, "{}x{}", img.width(), img.height());
+    // Red-wall and green-wall pixels in the image area (right of the panel), red left of green.
+    let (mut red, mut green) = (Vec::new(), Vec::new());
+    for (x, _, p) in img.enumerate_pixels() {
+        let [r, g, b] = p.0.map(|c| c as i32);
+        if r > 60 && r > 2 * g && r > 2 * b {
+            red.push(x);
+        }
+        if g > 40 && g > 2 * r && g > 2 * b {
+            green.push(x);
+        }
+    }
+    assert!(red.len() > 500 && green.len() > 500, "walls visible: {} red, {} green pixels", red.len(), green.len());
+    let mean = |v: &[u32]| v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
+    assert!(mean(&red) < mean(&green), "red wall on the left");
+    assert!(mean(&red) > 250.0, "the render sits right of the side panel");
+    // The side panel: light text on a dark background in the left strip.
+    let text =
+        (0..200).flat_map(|x| (0..200).map(move |y| (x, y))).filter(|&(x, y)| img.get_pixel(x, y).0[0] > 150).count();
+    assert!(text > 200, "the side panel shows text ({text} light pixels)");
+}
