@@ -33,6 +33,8 @@ pub fn tonemap_aces(x: Vec3) -> Vec3 {
     ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(Vec3::ZERO, Vec3::ONE)
 }
 
+// The matrices keep the published digits so the twin reads like the WGSL.
+#[allow(clippy::excessive_precision)]
 pub fn tonemap_agx(c: Vec3) -> Vec3 {
     let inset = Mat3::from_cols(
         Vec3::new(0.842479062253094, 0.0423282422610123, 0.0423756549057051),
