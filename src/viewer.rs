@@ -47,8 +47,7 @@ pub fn run(options: ViewOptions) -> Result<(), Error> {
         }),
     )
     .map_err(|e| Error::Gpu(format!("cannot open the viewer window: {e}")))?;
-    let r = result.lock().map(|r| r.clone()).unwrap_or(Ok(()));
-    r
+    result.lock().map(|r| r.clone()).unwrap_or(Ok(()))
 }
 
 /// Mouse and keyboard camera: orbit about a target, pan, zoom, fly.
