@@ -78,7 +78,12 @@ struct Params {
     env_width: u32,
     env_height: u32,
     env_total: f32,
-    pad: u32,
+    // Thin-lens radius in scene units (0: a pinhole), and the distance in focus.
+    aperture: f32,
+    focus_distance: f32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 struct Ray {

@@ -147,6 +147,6 @@ fn render_sample(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let pixel = vec2<u32>(gid.x + params.tile_x, gid.y + params.tile_y);
     var rng = rng_init(pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
-    let ray = generate_ray(pixel, rng_next2(&rng));
+    let ray = generate_ray(pixel, rng_next2(&rng), &rng);
     film_add_sample(gid.y * params.film_width + gid.x, li(ray, &rng));
 }

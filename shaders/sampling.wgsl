@@ -21,6 +21,13 @@ fn sample_uniform_sphere(u: vec2<f32>) -> vec3<f32> {
 
 const UNIFORM_SPHERE_PDF: f32 = 0.07957747154594767;
 
+// Uniform point on the unit disk.
+fn sample_uniform_disk(u: vec2<f32>) -> vec2<f32> {
+    let r = sqrt(u.x);
+    let phi = 2.0 * PI * u.y;
+    return vec2<f32>(r * cos(phi), r * sin(phi));
+}
+
 // Uniform point on a triangle as barycentrics (b1, b2) of vertices 1 and 2.
 fn sample_uniform_triangle(u: vec2<f32>) -> vec2<f32> {
     let su = sqrt(u.x);

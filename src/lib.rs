@@ -99,6 +99,10 @@ pub struct Settings {
     /// Overrides the scene's environment radiance.
     pub environment: Option<Vec3>,
     pub tile: Option<Tile>,
+    /// Thin-lens radius in scene units (0: a pinhole camera).
+    pub aperture: f32,
+    /// Distance in focus; None with an aperture: what the image centre sees.
+    pub focus_distance: Option<f32>,
 }
 
 impl Default for Settings {
@@ -112,8 +116,26 @@ impl Default for Settings {
             camera: None,
             environment: None,
             tile: None,
+            aperture: 0.0,
+            focus_distance: None,
         }
     }
+}
+
+/// The render parameters of `settings` for `camera`, with the lens set up.
+fn make_params(scene: &PackedScene, camera: &scene::Camera, settings: &Settings, tile: Tile) -> Params {
+    let env = settings.environment.unwrap_or(scene.environment);
+    let (w, h) = (settings.width, settings.height);
+    let mut params =
+        Params::new(camera, (w, h), tile, settings.seed, settings.max_depth, settings.strategy, env, scene);
+    if settings.aperture > 0.0 && settings.aperture.is_finite() {
+        params.aperture = settings.aperture;
+        params.focus_distance = match settings.focus_distance {
+            Some(d) if d.is_finite() && d > 0.0 => d,
+            _ => cpu::camera::autofocus(scene, &params),
+        };
+    }
+    params
 }
 
 /// Everything that defines a render, saved in every EXR veach writes so that a render can be
@@ -135,6 +157,10 @@ pub struct Job {
     /// Sample indices `sample_start .. sample_end` make up this render.
     pub sample_start: u32,
     pub sample_end: u32,
+    #[serde(default)]
+    pub aperture: f32,
+    #[serde(default)]
+    pub focus_distance: Option<f32>,
 }
 
 impl Job {
@@ -148,6 +174,8 @@ impl Job {
             camera: self.camera.clone(),
             environment: None,
             tile: self.tile,
+            aperture: self.aperture,
+            focus_distance: self.focus_distance,
         }
     }
 
@@ -204,9 +232,7 @@ impl Renderer {
                 tile.x, tile.y, tile.width, tile.height
             )));
         }
-        let env = settings.environment.unwrap_or(scene.environment);
-        let params =
-            Params::new(camera, (w, h), tile, settings.seed, settings.max_depth, settings.strategy, env, &scene);
+        let params = make_params(&scene, camera, settings, tile);
         // The film must fit in memory (and, on the GPU, in one storage binding; checked there).
         let film_bytes = tile.width as u64 * tile.height as u64 * (film::WORDS_PER_PIXEL * 4) as u64;
         if film_bytes > MAX_FILM_BYTES {
@@ -295,9 +321,7 @@ impl Renderer {
             return Err(Error::Limit(format!("image size {w}x{h} is outside 1..={MAX_IMAGE_SIDE} per side")));
         }
         let tile = settings.tile.unwrap_or(Tile { x: 0, y: 0, width: w, height: h });
-        let env = settings.environment.unwrap_or(self.scene.environment);
-        self.params =
-            Params::new(camera, (w, h), tile, settings.seed, settings.max_depth, settings.strategy, env, &self.scene);
+        self.params = make_params(&self.scene, camera, settings, tile);
         match &mut self.engine {
             Engine::Gpu(g) => g.reset(self.params),
             Engine::Cpu(f) => {

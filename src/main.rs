@@ -31,8 +31,12 @@ enum Command {
     Merge(MergeArgs),
     /// Render the seed's four direct-lighting estimators at equal spp, side by side with labels.
     Strategies(StrategiesArgs),
-    /// List the Vulkan adapters and their limits.
-    Info,
+    /// List the Vulkan adapters and their limits, or describe a scene.
+    Info {
+        /// A .gltf/.glb file: print its triangles, meshes, instances, materials, textures,
+        /// lights, extensions and bounds.
+        scene: Option<PathBuf>,
+    },
 }
 
 #[derive(clap::Args)]
@@ -108,16 +112,31 @@ struct StrategiesArgs {
     tonemap: Tonemap,
     #[arg(long, value_enum)]
     backend: Option<Backend>,
+    #[command(flatten)]
+    look: LookArgs,
+}
+
+/// What the camera sees: which camera, and the environment.
+#[derive(clap::Args)]
+struct LookArgs {
+    /// Camera node name (default: the first camera, else a view framing the scene).
     #[arg(long)]
     camera: Option<String>,
+    /// Constant environment radiance R,G,B (default: the scene's extras.environment, else black).
     #[arg(long, value_parser = parse_rgb)]
     env_color: Option<Vec3>,
-    /// Equirectangular environment map (.hdr or .exr), importance-sampled.
+    /// Equirectangular environment map (.hdr or .exr), importance-sampled; --env-color tints it.
     #[arg(long)]
     env: Option<PathBuf>,
     /// Scales the environment (map or color).
     #[arg(long, default_value_t = 1.0)]
     env_strength: f32,
+    /// Thin-lens radius in scene units for depth of field (default: a pinhole).
+    #[arg(long, default_value_t = 0.0)]
+    aperture: f32,
+    /// Distance in focus (default with --aperture: what the image centre sees).
+    #[arg(long)]
+    focus_distance: Option<f32>,
 }
 
 #[derive(clap::Args)]
@@ -156,18 +175,8 @@ struct RenderArgs {
     /// gpu (Vulkan; falls back to cpu with a warning when no adapter exists unless given explicitly) or cpu.
     #[arg(long, value_enum)]
     backend: Option<Backend>,
-    /// Camera node name (default: the first camera, else a view framing the scene).
-    #[arg(long)]
-    camera: Option<String>,
-    /// Constant environment radiance R,G,B (default: the scene's extras.environment, else black).
-    #[arg(long, value_parser = parse_rgb)]
-    env_color: Option<Vec3>,
-    /// Equirectangular environment map (.hdr or .exr), importance-sampled; --env-color tints it.
-    #[arg(long)]
-    env: Option<PathBuf>,
-    /// Scales the environment (map or color).
-    #[arg(long, default_value_t = 1.0)]
-    env_strength: f32,
+    #[command(flatten)]
+    look: LookArgs,
     /// Render only sample indices START..END (a render-farm split; overrides --spp). Random
     /// numbers are keyed by sample index, so parts merge (`veach merge`) into the full render.
     #[arg(long, value_parser = parse_range)]
@@ -233,7 +242,10 @@ fn main() -> ExitCode {
         Command::Merge(args) => merge(&args),
         Command::View(args) => view(args).map(|_| Outcome::Done),
         Command::Strategies(args) => strategies(&args).map(|_| Outcome::Done),
-        Command::Info => info().map(|_| Outcome::Done),
+        Command::Info { scene: Some(path) } => {
+            veach::scene::gltf::describe_file(&path).map(|text| println!("{text}")).map(|_| Outcome::Done)
+        }
+        Command::Info { scene: None } => info().map(|_| Outcome::Done),
     };
     match result {
         Ok(Outcome::Done) => ExitCode::SUCCESS,
@@ -311,18 +323,20 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
             let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
             let job = Job {
                 scene: absolute(&scene),
-                camera: args.camera.clone(),
+                camera: args.look.camera.clone(),
                 width: args.width,
                 height: args.height,
                 max_depth: args.max_depth,
                 seed: args.seed,
                 strategy: args.strategy,
-                env_map: args.env.as_deref().map(absolute),
-                env_color: args.env_color.map(Into::into),
-                env_strength: args.env_strength,
+                env_map: args.look.env.as_deref().map(absolute),
+                env_color: args.look.env_color.map(Into::into),
+                env_strength: args.look.env_strength,
                 tile: args.tile,
                 sample_start,
                 sample_end,
+                aperture: args.look.aperture,
+                focus_distance: args.look.focus_distance,
             };
             (job, None)
         }
@@ -557,8 +571,8 @@ fn strategies(args: &StrategiesArgs) -> Result<(), Error> {
     if args.spp == 0 {
         return Err(Error::Input("--spp must be at least 1".into()));
     }
-    let (mut scene, camera) = veach::load(&args.scene, args.camera.as_deref())?;
-    set_environment(&mut scene, args.env.as_deref(), args.env_color, args.env_strength)?;
+    let (mut scene, camera) = veach::load(&args.scene, args.look.camera.as_deref())?;
+    set_environment(&mut scene, args.look.env.as_deref(), args.look.env_color, args.look.env_strength)?;
     let packed = veach::packed::PackedScene::new(&scene);
     let (w, h) = (args.width, args.height);
     let bar = 14 * 3;
@@ -573,9 +587,11 @@ fn strategies(args: &StrategiesArgs) -> Result<(), Error> {
             max_depth: args.max_depth,
             seed: args.seed,
             strategy,
-            camera: args.camera.clone(),
+            camera: args.look.camera.clone(),
             environment: None,
             tile: None,
+            aperture: args.look.aperture,
+            focus_distance: args.look.focus_distance,
         };
         let mut renderer = open_renderer(packed.clone(), &camera, &settings, backend)?;
         backend = Some(renderer.backend());

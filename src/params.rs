@@ -32,7 +32,11 @@ pub struct Params {
     pub env_width: u32,
     pub env_height: u32,
     pub env_total: f32,
-    pub pad: u32,
+    /// Thin-lens radius in scene units (0: a pinhole).
+    pub aperture: f32,
+    /// Distance of the plane in focus, along the view direction.
+    pub focus_distance: f32,
+    pub pad: [u32; 3],
 }
 
 /// Russian roulette starts once a path has this many segments.
@@ -88,7 +92,9 @@ impl Params {
             env_width: scene.env_width,
             env_height: scene.env_height,
             env_total: scene.env_total,
-            pad: 0,
+            aperture: 0.0,
+            focus_distance: 1.0,
+            pad: [0; 3],
         }
     }
 }

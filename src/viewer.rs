@@ -261,6 +261,24 @@ impl Viewer {
             self.orbit.pitch = (self.orbit.pitch - d.y * 0.005).clamp(-1.55, 1.55);
             changed |= d != egui::Vec2::ZERO;
         }
+        // A click focuses the lens on what is under the pointer.
+        if response.clicked()
+            && let (Some(p), Some(r)) = (response.interact_pointer_pos(), &self.renderer)
+        {
+            let uv = (p - response.rect.min) / response.rect.size();
+            let params = crate::params::Params { aperture: 0.0, ..*r.params() };
+            let pixel = glam::UVec2::new(
+                (uv.x * self.settings.width as f32).max(0.0) as u32,
+                (uv.y * self.settings.height as f32).max(0.0) as u32,
+            );
+            let ray = crate::cpu::camera::generate_ray(&params, pixel, glam::Vec2::splat(0.5), &mut 0);
+            let hit = crate::cpu::bvh::intersect_closest(&r.scene().nodes, &r.scene().triangles, &ray);
+            if hit.tri != crate::cpu::bvh::NO_HIT {
+                self.settings.focus_distance = Some(hit.t * ray.dir.dot(Vec3::from(params.cam_forward)));
+                self.status = format!("focus distance {:.4}", self.settings.focus_distance.unwrap_or(0.0));
+                changed = true;
+            }
+        }
         if response.hovered() {
             let s = ui.input(|i| i.smooth_scroll_delta);
             let wheel = s.x + s.y;
@@ -326,6 +344,18 @@ impl Viewer {
         ui.add(egui::Slider::new(&mut self.settings.max_depth, 0..=32).text("max depth (0 = ∞)"));
         ui.add(egui::Slider::new(&mut self.env_strength, 0.0..=10.0).text("environment"));
         changed |= before != (self.settings.strategy, self.settings.max_depth, self.env_strength);
+        let max_aperture = 0.05 * self.extent;
+        changed |=
+            ui.add(egui::Slider::new(&mut self.settings.aperture, 0.0..=max_aperture).text("aperture (DOF)")).changed();
+        let mut focus = self.settings.focus_distance.unwrap_or(self.orbit.distance);
+        if ui
+            .add(egui::Slider::new(&mut focus, 1e-3 * self.extent..=2.0 * self.extent).text("focus distance"))
+            .changed()
+        {
+            self.settings.focus_distance = Some(focus);
+            changed = true;
+        }
+        ui.label("click the image to focus there");
         ui.add(egui::Slider::new(&mut self.exposure, -8.0..=8.0).text("exposure (EV)"));
         egui::ComboBox::from_label("tone mapper").selected_text(self.tonemap.name()).show_ui(ui, |ui| {
             for t in Tonemap::ALL {

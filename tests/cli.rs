@@ -166,6 +166,25 @@ fn environment_maps_from_hdr_and_exr() {
 }
 
 #[test]
+fn info_describes_a_scene() {
+    let scene = common::asset("cornell-box.gltf");
+    let r = veach(&["info", scene.to_str().unwrap()], &[]);
+    let out = String::from_utf8_lossy(&r.stdout);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    for needle in [
+        "triangles 32 (2 emissive)",
+        "meshes 8",
+        "instances (nodes with a mesh) 8",
+        "materials 4",
+        "cameras 1",
+        "KHR_materials_emissive_strength",
+        "bounds",
+    ] {
+        assert!(out.contains(needle), "'{needle}' missing in:\n{out}");
+    }
+}
+
+#[test]
 fn strategies_sheet_has_four_labelled_panels() {
     let d = temp_dir("sheet");
     let out = d.join("sheet.png");

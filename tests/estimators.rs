@@ -65,7 +65,7 @@ fn plate_masks() -> Vec<Vec<usize>> {
     let mut plates = vec![Vec::new(); 4];
     for y in 0..64 {
         for x in 0..64 {
-            let ray = veach::cpu::camera::generate_ray(&params, UVec2::new(x, y), Vec2::splat(0.5));
+            let ray = veach::cpu::camera::generate_ray(&params, UVec2::new(x, y), Vec2::splat(0.5), &mut 0);
             let hit = intersect_closest(&packed.nodes, &packed.triangles, &ray);
             if hit.tri != NO_HIT {
                 let m = packed.triangles[hit.tri as usize].material as usize;

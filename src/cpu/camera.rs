@@ -1,12 +1,30 @@
 //! Twin of `shaders/camera.wgsl`.
 
 use super::bvh::Ray;
+use super::rng::rng_next2;
+use super::sampling::sample_uniform_disk;
 use crate::params::Params;
 use glam::{UVec2, Vec2, Vec3};
 
-pub fn generate_ray(params: &Params, pixel: UVec2, u: Vec2) -> Ray {
+pub fn generate_ray(params: &Params, pixel: UVec2, u: Vec2, rng: &mut u32) -> Ray {
     let x = (pixel.x as f32 + u.x) / params.image_width as f32 * 2.0 - 1.0;
     let y = 1.0 - (pixel.y as f32 + u.y) / params.image_height as f32 * 2.0;
-    let dir = Vec3::from(params.cam_forward) + x * Vec3::from(params.cam_right) + y * Vec3::from(params.cam_up);
-    Ray { origin: params.cam_position.into(), dir: dir.normalize() }
+    let (forward, right, up) =
+        (Vec3::from(params.cam_forward), Vec3::from(params.cam_right), Vec3::from(params.cam_up));
+    let position = Vec3::from(params.cam_position);
+    let dir = (forward + x * right + y * up).normalize();
+    if params.aperture <= 0.0 {
+        return Ray { origin: position, dir };
+    }
+    let focus = position + dir * (params.focus_distance / dir.dot(forward));
+    let lens = sample_uniform_disk(rng_next2(rng)) * params.aperture;
+    let origin = position + lens.x * right.normalize() + lens.y * up.normalize();
+    Ray { origin, dir: (focus - origin).normalize() }
+}
+
+/// The distance in focus when only an aperture is given: what the image centre sees.
+pub fn autofocus(scene: &crate::packed::PackedScene, params: &Params) -> f32 {
+    let ray = Ray { origin: params.cam_position.into(), dir: Vec3::from(params.cam_forward).normalize() };
+    let hit = super::bvh::intersect_closest(&scene.nodes, &scene.triangles, &ray);
+    if hit.tri != super::bvh::NO_HIT { hit.t } else { 0.5 * scene.extent }
 }

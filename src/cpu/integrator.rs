@@ -139,6 +139,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
 pub fn render_sample(scene: &PackedScene, params: &Params, x: u32, y: u32) -> Vec3 {
     let pixel = UVec2::new(x + params.tile_x, y + params.tile_y);
     let mut rng = rng_init(pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
-    let ray = generate_ray(params, pixel, rng_next2(&mut rng));
+    let jitter = rng_next2(&mut rng);
+    let ray = generate_ray(params, pixel, jitter, &mut rng);
     li(scene, params, ray, &mut rng)
 }

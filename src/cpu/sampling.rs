@@ -22,6 +22,12 @@ pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
 
 pub const UNIFORM_SPHERE_PDF: f32 = 0.079_577_47;
 
+pub fn sample_uniform_disk(u: Vec2) -> Vec2 {
+    let r = u.x.sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec2::new(r * phi.cos(), r * phi.sin())
+}
+
 pub fn sample_uniform_triangle(u: Vec2) -> Vec2 {
     let su = u.x.sqrt();
     Vec2::new(1.0 - su, u.y * su)

@@ -78,6 +78,51 @@ fn contained<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     result.map_err(|_| "invalid glTF: an index or reference is out of range".to_string())
 }
 
+/// A summary of a glTF file for `veach info SCENE`: what the file holds and what veach loads.
+pub fn describe_file(path: &Path) -> Result<String, Error> {
+    let scene = load(path)?;
+    let fail = |m: String| Error::Input(format!("{}: {m}", path.display()));
+    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    let json = if bytes.starts_with(b"glTF") { glb_json_chunk(&bytes).map_err(fail)? } else { &bytes[..] };
+    let raw: serde_json::Value = serde_json::from_slice(json).map_err(|e| fail(format!("invalid glTF JSON: {e}")))?;
+    let count = |key: &str| raw.get(key).and_then(|v| v.as_array()).map_or(0, |a| a.len());
+    let instances = raw
+        .get("nodes")
+        .and_then(|v| v.as_array())
+        .map_or(0, |nodes| nodes.iter().filter(|n| n.get("mesh").is_some()).count());
+    let punctual =
+        raw.pointer("/extensions/KHR_lights_punctual/lights").and_then(|v| v.as_array()).map_or(0, |a| a.len());
+    let list = |key: &str| -> String {
+        let v: Vec<&str> = raw
+            .get(key)
+            .and_then(|v| v.as_array())
+            .map(|a| a.iter().filter_map(|x| x.as_str()).collect())
+            .unwrap_or_default();
+        if v.is_empty() { "none".into() } else { v.join(", ") }
+    };
+    let b = scene.bounds();
+    let bounds = if b.is_empty() { "empty".to_string() } else { format!("{} .. {}", b.min, b.max) };
+    let cameras: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
+    Ok(format!(
+        "{}\n  triangles {} ({} emissive)\n  meshes {}\n  instances (nodes with a mesh) {}\n  materials {}\n  textures {} (images {})\n  \
+         punctual lights {}\n  cameras {} ({})\n  extensions used: {}\n  extensions required: {}\n  bounds {}",
+        path.display(),
+        scene.triangles.len(),
+        scene.emissive_triangle_count(),
+        count("meshes"),
+        instances,
+        count("materials"),
+        count("textures"),
+        count("images"),
+        punctual,
+        cameras.len(),
+        cameras.join(", "),
+        list("extensionsUsed"),
+        list("extensionsRequired"),
+        bounds,
+    ))
+}
+
 /// The JSON chunk of a GLB, after checking the container's header and chunk bounds.
 fn glb_json_chunk(bytes: &[u8]) -> Result<&[u8], String> {
     let word = |at: usize| -> Result<u32, String> {

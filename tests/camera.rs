@@ -1,0 +1,73 @@
+//! The thin-lens camera: rays through any point of the lens meet on the plane in focus, the
+//! GPU and CPU agree with a lens, and an aperture alone focuses on what the centre sees.
+
+mod common;
+
+use common::*;
+use glam::{UVec2, Vec2, Vec3};
+use veach::cpu::camera::{autofocus, generate_ray};
+use veach::packed::PackedScene;
+use veach::params::Params;
+use veach::{Strategy, Tile};
+
+fn params(aperture: f32, focus: f32) -> (PackedScene, Params) {
+    let (scene, camera) = veach::load(&asset("cornell-box.gltf"), None).unwrap();
+    let packed = PackedScene::new(&scene);
+    let tile = Tile { x: 0, y: 0, width: 64, height: 48 };
+    let mut p = Params::new(&camera, (64, 48), tile, 0, 8, Strategy::MisPower, Vec3::ZERO, &packed);
+    p.aperture = aperture;
+    p.focus_distance = focus;
+    (packed, p)
+}
+
+#[test]
+fn lens_rays_meet_on_the_plane_in_focus() {
+    let (_, pinhole) = params(0.0, 1.0);
+    let (_, lens) = params(25.0, 1000.0);
+    let forward = Vec3::from(pinhole.cam_forward);
+    for k in 0..200u32 {
+        let pixel = UVec2::new(k * 7 % 64, k * 13 % 48);
+        let jitter = Vec2::new((k as f32 * 0.37).fract(), (k as f32 * 0.61).fract());
+        let centre = generate_ray(&pinhole, pixel, jitter, &mut 0);
+        let mut rng = k;
+        let r = generate_ray(&lens, pixel, jitter, &mut rng);
+        assert!(r.origin.distance(centre.origin) <= 25.0 + 1e-3 && r.origin != centre.origin);
+        // Both rays reach the plane at distance 1000 along the view direction at one point.
+        let at = |ray: &veach::cpu::bvh::Ray| {
+            ray.origin + ray.dir * ((1000.0 - (ray.origin - centre.origin).dot(forward)) / ray.dir.dot(forward))
+        };
+        assert!(at(&r).distance(at(&centre)) < 1e-2, "pixel {pixel}: {} vs {}", at(&r), at(&centre));
+    }
+}
+
+#[test]
+fn aperture_alone_focuses_on_what_the_centre_sees() {
+    let (scene, p) = params(10.0, 0.0);
+    let d = autofocus(&scene, &p);
+    // The camera is 800 mm in front of the box, whose back wall is 559 mm deep.
+    assert!((800.0..=1360.0).contains(&d), "focus distance {d}");
+}
+
+#[test]
+fn gpu_and_cpu_agree_with_a_lens() {
+    let Some(ctx) = gpu("gpu_and_cpu_agree_with_a_lens") else { return };
+    let mut s = settings(48, 8, 31);
+    s.aperture = 30.0;
+    let g = render(&asset("cornell-box.gltf"), &s, 128, Some(ctx));
+    s.seed = 32;
+    let c = render(&asset("cornell-box.gltf"), &s, 128, None);
+    let (gm, gv) = film_stats(&g);
+    let (cm, cv) = film_stats(&c);
+    let a = agreement(&gm, &gv, &cm, &cv);
+    eprintln!("lens gpu vs cpu: {a:?}");
+    assert!(a.mean_z.abs().max_element() < 5.0 && a.mean_rel.abs().max_element() < 0.02 && a.outliers < 0.01, "{a:?}");
+    // And a wide lens focused near the camera blurs the box: the light's and walls' edges.
+    let mut wide = settings(48, 8, 33);
+    (wide.aperture, wide.focus_distance) = (150.0, Some(850.0));
+    let blurred = render(&asset("cornell-box.gltf"), &wide, 128, None);
+    let pinhole = render(&asset("cornell-box.gltf"), &settings(48, 8, 34), 128, None);
+    let (bm, bv) = film_stats(&blurred);
+    let (pm, pv) = film_stats(&pinhole);
+    let d = agreement(&bm, &bv, &pm, &pv);
+    assert!(d.outliers > 0.02, "depth of field is visible: {d:?}");
+}
