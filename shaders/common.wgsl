@@ -81,7 +81,8 @@ struct Params {
     // Thin-lens radius in scene units (0: a pinhole), and the distance in focus.
     aperture: f32,
     focus_distance: f32,
-    pad0: u32,
+    // First film row of this dispatch (the viewer renders a sample in bands of rows).
+    row_offset: u32,
     pad1: u32,
     pad2: u32,
 }

@@ -142,11 +142,12 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
 
 @compute @workgroup_size(8, 8, 1)
 fn render_sample(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= params.film_width || gid.y >= params.film_height) {
+    let row = gid.y + params.row_offset;
+    if (gid.x >= params.film_width || row >= params.film_height) {
         return;
     }
-    let pixel = vec2<u32>(gid.x + params.tile_x, gid.y + params.tile_y);
+    let pixel = vec2<u32>(gid.x + params.tile_x, row + params.tile_y);
     var rng = rng_init(pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
     let ray = generate_ray(pixel, rng_next2(&rng), &rng);
-    film_add_sample(gid.y * params.film_width + gid.x, li(ray, &rng));
+    film_add_sample(row * params.film_width + gid.x, li(ray, &rng));
 }

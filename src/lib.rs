@@ -306,6 +306,27 @@ impl Renderer {
         }
     }
 
+    /// Accumulates sample `sample` for film rows `y0 .. y0 + rows` only: the viewer's way to
+    /// keep each frame short. `y0` and `rows` must be multiples of 8.
+    pub fn render_rows(&mut self, sample: u32, y0: u32, rows: u32) -> Result<(), Error> {
+        if !y0.is_multiple_of(8) || !rows.is_multiple_of(8) {
+            return Err(Error::Input(format!("row band {y0}+{rows} is not aligned to 8 rows")));
+        }
+        match &mut self.engine {
+            Engine::Gpu(g) => g.render_rows(sample, y0, rows),
+            Engine::Cpu(film) => {
+                let p = Params { sample_index: sample, ..self.params };
+                let (w, h) = (p.film_width, p.film_height);
+                for y in y0..(y0 + rows).min(h) {
+                    for x in 0..w {
+                        film.add_sample((y * w + x) as usize, cpu::render_sample(&self.scene, &p, x, y));
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+
     /// The accumulated film (a readback on the GPU).
     pub fn film(&self) -> Result<Film, Error> {
         match &self.engine {

@@ -57,9 +57,8 @@ struct ViewArgs {
     /// Window size WxH in points.
     #[arg(long, value_parser = parse_size, default_value = "1100x720")]
     window: (u32, u32),
-    /// Fraction of the image area's resolution rendered (lavapipe renders 1 spp of a full
-    /// window in about 2 s; 0.5 keeps the window responsive).
-    #[arg(long, default_value_t = 0.5)]
+    /// Fraction of the image area's resolution rendered when the camera is still.
+    #[arg(long, default_value_t = 1.0)]
     render_scale: f32,
 }
 

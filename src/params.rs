@@ -36,7 +36,9 @@ pub struct Params {
     pub aperture: f32,
     /// Distance of the plane in focus, along the view direction.
     pub focus_distance: f32,
-    pub pad: [u32; 3],
+    /// First film row of this dispatch (the viewer renders a sample in bands of rows).
+    pub row_offset: u32,
+    pub pad: [u32; 2],
 }
 
 /// Russian roulette starts once a path has this many segments.
@@ -94,7 +96,8 @@ impl Params {
             env_total: scene.env_total,
             aperture: 0.0,
             focus_distance: 1.0,
-            pad: [0; 3],
+            row_offset: 0,
+            pad: [0; 2],
         }
     }
 }

@@ -108,7 +108,9 @@ struct Viewer {
     paused: bool,
     target_spp: u32,
     samples: u32,
-    batch: u32,
+    /// Next film row of the sample in progress, and rows per dispatch (multiples of 8).
+    row: u32,
+    band: u32,
     rate: f64,
     scale_moving: f32,
     scale: f32,
@@ -145,9 +147,10 @@ impl Viewer {
             paused: false,
             target_spp: 4096,
             samples: 0,
-            batch: 1,
+            row: 0,
+            band: 8,
             rate: 0.0,
-            scale_moving: 0.5,
+            scale_moving: 0.25,
             scale: options.render_scale.clamp(0.05, 1.0),
             moving: false,
             dirty: true,
@@ -242,6 +245,7 @@ impl Viewer {
             self.error = Some(e.to_string());
         }
         self.samples = 0;
+        self.row = 0;
         self.dirty = false;
     }
 
@@ -454,21 +458,33 @@ impl eframe::App for Viewer {
             if changed || moved || self.dirty || was_moving != self.moving || full != self.settings.width {
                 self.restart(w, h);
             }
-            // Progressive refinement: as many samples as fit about 30 ms of GPU work.
+            // Progressive refinement within about 30 ms of GPU work per frame: a sample is
+            // rendered in bands of rows sized to ~10 ms each, so even a slow device (lavapipe
+            // takes seconds per full-window sample) keeps the window responsive.
             if let Some(r) = &mut self.renderer
                 && !self.paused
-                && self.samples < self.target_spp
             {
-                let n = self.batch.min(self.target_spp - self.samples);
+                let (w, h) = (self.settings.width, self.settings.height.next_multiple_of(8));
                 let t = Instant::now();
-                match r.render_samples(self.samples, n) {
-                    Ok(()) => {
-                        let secs = t.elapsed().as_secs_f64().max(1e-6);
-                        self.samples += n;
-                        self.rate = n as f64 * self.settings.width as f64 * self.settings.height as f64 / secs;
-                        self.batch = ((n as f64 * 0.030 / secs) as u32).clamp(1, 64);
+                let mut pixels = 0u64;
+                while self.samples < self.target_spp && t.elapsed().as_secs_f64() < 0.030 {
+                    let rows = self.band.min(h - self.row);
+                    let t1 = Instant::now();
+                    if let Err(e) = r.render_rows(self.samples, self.row, rows) {
+                        self.error = Some(e.to_string());
+                        break;
                     }
-                    Err(e) => self.error = Some(e.to_string()),
+                    let secs = t1.elapsed().as_secs_f64().max(1e-6);
+                    pixels += rows as u64 * w as u64;
+                    self.band = (((rows as f64 * 0.010 / secs) as u32) / 8 * 8).clamp(8, h);
+                    self.row += rows;
+                    if self.row >= h {
+                        self.row = 0;
+                        self.samples += 1;
+                    }
+                }
+                if pixels > 0 {
+                    self.rate = pixels as f64 / t.elapsed().as_secs_f64().max(1e-6);
                 }
             }
             if let Some(r) = &self.renderer

@@ -48,3 +48,31 @@ fn viewer_screenshot_shows_the_render_and_the_panel() {
         (0..200).flat_map(|x| (0..200).map(move |y| (x, y))).filter(|&(x, y)| img.get_pixel(x, y).0[0] > 150).count();
     assert!(text > 200, "the side panel shows text ({text} light pixels)");
 }
+
+/// The viewer accumulates a sample in bands of rows (to keep frames short); the film it builds
+/// is bit for bit the film `veach render` builds from whole-image dispatches.
+#[test]
+fn viewer_bands_build_the_same_film_as_render() {
+    let (scene, camera) = veach::load(&common::asset("cornell-box.gltf"), None).unwrap();
+    let mut backends = vec![None];
+    if let Some(ctx) = common::gpu("viewer_bands_build_the_same_film_as_render") {
+        backends.push(Some(ctx));
+    }
+    for ctx in backends {
+        let backend = if ctx.is_some() { veach::Backend::Gpu } else { veach::Backend::Cpu };
+        let s = veach::Settings { width: 40, height: 28, ..common::settings(40, 8, 3) };
+        let packed = veach::packed::PackedScene::new(&scene);
+        let mut whole = veach::Renderer::new(packed.clone(), &camera, &s, veach::Backend::Cpu).unwrap();
+        if backend == veach::Backend::Gpu {
+            whole = veach::Renderer::with_gpu(packed.clone(), &camera, &s, backend, common::gpu("bands")).unwrap();
+        }
+        whole.render_samples(0, 3).unwrap();
+        let mut bands = veach::Renderer::with_gpu(packed, &camera, &s, backend, ctx).unwrap();
+        for sample in 0..3 {
+            for (y0, rows) in [(0, 8), (8, 16), (24, 8)] {
+                bands.render_rows(sample, y0, rows).unwrap();
+            }
+        }
+        assert!(whole.film().unwrap() == bands.film().unwrap(), "{backend:?}: bands = whole samples");
+    }
+}

@@ -335,6 +335,22 @@ impl GpuRenderer {
         Ok(())
     }
 
+    /// Renders sample `sample` of film rows `y0 .. y0 + rows` only (`y0` and `rows` multiples
+    /// of 8, the workgroup height, so that bands never overlap).
+    pub fn render_rows(&mut self, sample: u32, y0: u32, rows: u32) -> Result<(), Error> {
+        let p = Params { sample_index: sample, row_offset: y0, ..self.params };
+        self.ctx.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&p));
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.bind_group, &[0]);
+            pass.dispatch_workgroups(self.params.film_width.div_ceil(8), rows.div_ceil(8), 1);
+        }
+        let index = self.ctx.queue.submit([encoder.finish()]);
+        self.wait(index)
+    }
+
     fn wait(&self, index: wgpu::SubmissionIndex) -> Result<(), Error> {
         self.ctx
             .device
