@@ -52,44 +52,36 @@ fn environment_pdf(dir: vec3<f32>) -> f32 {
     return params.env_select * pdf_uv / (2.0 * PI * PI * sin_dir);
 }
 
-// A direction drawn with density ∝ environment_pdf.
+// Inverts a piecewise-constant CDF stored in env_texels[base .. base + n] (the marginal CDF in
+// .x, a row's conditional CDF in .w): the first entry above u, and u's place inside it.
+fn env_sample_cdf(base: u32, n: u32, u: f32, marginal: bool) -> vec2<f32> {
+    var lo = 0u;
+    var hi = n - 1u;
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        let t = env_texels[base + mid];
+        if (select(t.w, t.x, marginal) > u) {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    let before = env_texels[base + max(lo, 1u) - 1u];
+    let c0 = select(0.0, select(before.w, before.x, marginal), lo > 0u);
+    let t = env_texels[base + lo];
+    let c1 = select(t.w, t.x, marginal);
+    return vec2<f32>(f32(lo), clamp((u - c0) / max(c1 - c0, 1e-30), 0.0, 0.99999));
+}
+
+// A direction drawn with density ∝ environment_pdf: a row from the marginal CDF, then a
+// column from that row's conditional CDF, then uniformly inside the texel.
 fn sample_environment(u: vec2<f32>) -> vec3<f32> {
     if (params.env_width == 0u) {
         return sample_uniform_sphere(u);
     }
     let w = params.env_width;
     let h = params.env_height;
-    // Row from the marginal CDF: the first row whose CDF exceeds u.x.
-    let base = w * h;
-    var lo = 0u;
-    var hi = h - 1u;
-    while (lo < hi) {
-        let mid = (lo + hi) / 2u;
-        if (env_texels[base + mid].x > u.x) {
-            hi = mid;
-        } else {
-            lo = mid + 1u;
-        }
-    }
-    let i = lo;
-    let r0 = select(0.0, env_texels[base + i - 1u].x, i > 0u);
-    let r1 = env_texels[base + i].x;
-    let dv = clamp((u.x - r0) / max(r1 - r0, 1e-30), 0.0, 0.99999);
-    // Column from the row's conditional CDF.
-    let row = i * w;
-    lo = 0u;
-    hi = w - 1u;
-    while (lo < hi) {
-        let mid = (lo + hi) / 2u;
-        if (env_texels[row + mid].w > u.y) {
-            hi = mid;
-        } else {
-            lo = mid + 1u;
-        }
-    }
-    let j = lo;
-    let c0 = select(0.0, env_texels[row + j - 1u].w, j > 0u);
-    let c1 = env_texels[row + j].w;
-    let du = clamp((u.y - c0) / max(c1 - c0, 1e-30), 0.0, 0.99999);
-    return env_direction(vec2<f32>((f32(j) + du) / f32(w), (f32(i) + dv) / f32(h)));
+    let row = env_sample_cdf(w * h, h, u.x, true);
+    let column = env_sample_cdf(u32(row.x) * w, w, u.y, false);
+    return env_direction(vec2<f32>((column.x + column.y) / f32(w), (row.x + row.y) / f32(h)));
 }

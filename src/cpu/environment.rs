@@ -52,8 +52,10 @@ pub fn environment_pdf(scene: &PackedScene, params: &Params, dir: Vec3) -> f32 {
     params.env_select * pdf_uv / (2.0 * PI * PI * sin_dir)
 }
 
-/// The first index in `0..n` whose CDF value exceeds `u` (binary search).
-fn search(n: u32, u: f32, cdf: impl Fn(u32) -> f32) -> u32 {
+/// Twin of `env_sample_cdf`: inverts the CDF in `scene.env[base .. base + n]` (component 0 for
+/// the marginal, 3 for a row), returning the entry and `u`'s place inside it.
+pub fn env_sample_cdf(scene: &PackedScene, base: u32, n: u32, u: f32, marginal: bool) -> Vec2 {
+    let cdf = |k: u32| scene.env[(base + k) as usize][if marginal { 0 } else { 3 }];
     let (mut lo, mut hi) = (0u32, n - 1);
     while lo < hi {
         let mid = (lo + hi) / 2;
@@ -63,7 +65,9 @@ fn search(n: u32, u: f32, cdf: impl Fn(u32) -> f32) -> u32 {
             lo = mid + 1;
         }
     }
-    lo
+    let c0 = if lo > 0 { cdf(lo - 1) } else { 0.0 };
+    let c1 = cdf(lo);
+    Vec2::new(lo as f32, ((u - c0) / (c1 - c0).max(1e-30)).clamp(0.0, 0.99999))
 }
 
 pub fn sample_environment(scene: &PackedScene, params: &Params, u: Vec2) -> Vec3 {
@@ -71,15 +75,7 @@ pub fn sample_environment(scene: &PackedScene, params: &Params, u: Vec2) -> Vec3
         return sample_uniform_sphere(u);
     }
     let (w, h) = (params.env_width, params.env_height);
-    let base = (w * h) as usize;
-    let i = search(h, u.x, |k| scene.env[base + k as usize][0]);
-    let r0 = if i > 0 { scene.env[base + i as usize - 1][0] } else { 0.0 };
-    let r1 = scene.env[base + i as usize][0];
-    let dv = ((u.x - r0) / (r1 - r0).max(1e-30)).clamp(0.0, 0.99999);
-    let row = (i * w) as usize;
-    let j = search(w, u.y, |k| scene.env[row + k as usize][3]);
-    let c0 = if j > 0 { scene.env[row + j as usize - 1][3] } else { 0.0 };
-    let c1 = scene.env[row + j as usize][3];
-    let du = ((u.y - c0) / (c1 - c0).max(1e-30)).clamp(0.0, 0.99999);
-    env_direction(Vec2::new((j as f32 + du) / w as f32, (i as f32 + dv) / h as f32))
+    let row = env_sample_cdf(scene, w * h, h, u.x, true);
+    let column = env_sample_cdf(scene, row.x as u32 * w, w, u.y, false);
+    env_direction(Vec2::new((column.x + column.y) / w as f32, (row.x + row.y) / h as f32))
 }
