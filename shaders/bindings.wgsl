@@ -7,11 +7,15 @@
 @group(0) @binding(0) var<storage, read> params: Params;
 @group(0) @binding(1) var<storage, read> nodes: array<BvhNode>;
 @group(0) @binding(2) var<storage, read> triangles: array<Triangle>;
-@group(0) @binding(3) var<storage, read> normals: array<Normals>;
+@group(0) @binding(3) var<storage, read> attributes: array<Attributes>;
 @group(0) @binding(4) var<storage, read> materials: array<Material>;
 @group(0) @binding(5) var<storage, read> lights: array<LightEntry>;
-// Environment map texels (rgb, row CDF), then the marginal CDF of the rows (x).
-@group(0) @binding(7) var<storage, read> env_texels: array<vec4<f32>>;
 // Three rows per pixel (see film.wgsl): (Σ L high words, count), (Σ L low words, dropped
 // non-finite samples), (Σ L² as f32 bits, 0).
 @group(0) @binding(6) var<storage, read_write> film: array<vec4<u32>>;
+// Light data: environment map texels (rgb, row CDF), the marginal CDF of the rows (x), then
+// the punctual lights (four rows each, from params.punctual_base). One buffer for both keeps
+// the kernel within WebGPU's default of 8 storage buffers.
+@group(0) @binding(7) var<storage, read> env_texels: array<vec4<f32>>;
+// Every image of the scene, one square RGBA8 layer each (no binding arrays on lavapipe).
+@group(0) @binding(8) var textures: texture_2d_array<f32>;

@@ -1,9 +1,12 @@
 // glTF's metallic-roughness material as a path tracer reads it: a GGX specular lobe
-// (α = roughness²) whose Fresnel term blends the dielectric F0 (KHR_materials_specular/_ior)
-// and the base color by metallic, over a Lambertian lobe for the non-metal part weighted by
-// 1 − F so energy is conserved. α below DELTA_ALPHA is a perfect mirror (a Dirac lobe).
-// Everything in the local shading frame (normal = +z, wo.z > 0); eval, pdf and sample agree.
-// Twin: src/cpu/bsdf.rs.
+// (α = roughness²) whose Fresnel term blends the dielectric's and the base color by
+// metallic; under it, the non-metal part splits by KHR_materials_transmission into a
+// Lambertian lobe and a GGX transmission lobe (Walter et al. 2007), both weighted by 1 − F so
+// energy is conserved. α below DELTA_ALPHA makes the specular and transmission lobes Dirac
+// lobes (mirror, smooth glass).
+// Everything in the local shading frame (normal = +z, wo.z > 0). `eta` is the relative index
+// of refraction across the surface seen from wo (ior entering, 1/ior leaving); transmitted
+// directions have wi.z < 0. eval, pdf and sample agree. Twin: src/cpu/bsdf.rs.
 #include "common.wgsl"
 #include "sampling.wgsl"
 #include "microfacet.wgsl"
@@ -25,77 +28,189 @@ fn fresnel_schlick(f0: vec3<f32>, f90: vec3<f32>, cos_theta: f32) -> vec3<f32> {
     return f0 + (f90 - f0) * (m2 * m2 * m);
 }
 
-fn bsdf_fresnel(m: Material, cos_theta: f32) -> vec3<f32> {
-    let dielectric = fresnel_schlick(m.dielectric_f0, vec3<f32>(m.dielectric_f90), cos_theta);
+// Unpolarised Fresnel reflectance of a dielectric interface; 1 under total internal reflection.
+fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let c = clamp(cos_i, 0.0, 1.0);
+    let sin2_t = (1.0 - c * c) / (eta * eta);
+    if (sin2_t >= 1.0) {
+        return 1.0;
+    }
+    let cos_t = sqrt(1.0 - sin2_t);
+    let r_parl = (eta * c - cos_t) / (eta * c + cos_t);
+    let r_perp = (c - eta * cos_t) / (c + eta * cos_t);
+    return 0.5 * (r_parl * r_parl + r_perp * r_perp);
+}
+
+// The non-metal Fresnel: exact for transmissive materials (refraction needs the same F on
+// both sides, with total internal reflection), else Schlick with KHR_materials_specular.
+fn dielectric_fresnel(m: Material, cos_theta: f32, eta: f32) -> vec3<f32> {
+    if (m.transmission > 0.0) {
+        return vec3<f32>(fresnel_dielectric(cos_theta, eta));
+    }
+    return fresnel_schlick(m.dielectric_f0, vec3<f32>(m.dielectric_f90), cos_theta);
+}
+
+fn bsdf_fresnel(m: Material, cos_theta: f32, eta: f32) -> vec3<f32> {
     let metal = fresnel_schlick(m.base_color, vec3<f32>(1.0), cos_theta);
-    return mix(dielectric, metal, m.metallic);
+    return mix(dielectric_fresnel(m, cos_theta, eta), metal, m.metallic);
 }
 
 // Albedo of the Lambertian lobe seen from wo.
-fn diffuse_albedo(m: Material, cos_o: f32) -> vec3<f32> {
-    let f = fresnel_schlick(m.dielectric_f0, vec3<f32>(m.dielectric_f90), cos_o);
-    return (1.0 - m.metallic) * m.base_color * (vec3<f32>(1.0) - f);
+fn diffuse_albedo(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
+    let f = dielectric_fresnel(m, cos_o, eta);
+    return (1.0 - m.metallic) * (1.0 - m.transmission) * m.base_color * (vec3<f32>(1.0) - f);
 }
 
-// Probability of sampling the specular lobe, from the lobes' estimated albedos.
-fn specular_probability(m: Material, cos_o: f32) -> f32 {
-    let ws = luminance(bsdf_fresnel(m, cos_o));
-    let wd = luminance(diffuse_albedo(m, cos_o));
-    if (ws + wd <= 0.0) {
-        return 0.0;
+// Estimated albedo of the transmission lobe seen from wo.
+fn transmission_albedo(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
+    let f = dielectric_fresnel(m, cos_o, eta);
+    return (1.0 - m.metallic) * m.transmission * m.base_color * (vec3<f32>(1.0) - f);
+}
+
+// Probabilities of sampling the specular, diffuse and transmission lobes, from their albedos.
+// A rough interface transmits through some microfacets even beyond the critical angle of the
+// macro surface, so its transmission lobe keeps at least a tenth of its weight.
+fn lobe_probabilities(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
+    var wt = luminance(transmission_albedo(m, cos_o, eta));
+    if (m.roughness * m.roughness >= DELTA_ALPHA) {
+        wt = max(wt, 0.1 * (1.0 - m.metallic) * m.transmission * luminance(m.base_color));
     }
-    return ws / (ws + wd);
-}
-
-// f(wo, wi) without the cosine; the Dirac lobe is not included.
-fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
-    if (wo.z <= 0.0 || wi.z <= 0.0) {
+    let w = vec3<f32>(luminance(bsdf_fresnel(m, cos_o, eta)), luminance(diffuse_albedo(m, cos_o, eta)), wt);
+    let total = w.x + w.y + w.z;
+    if (total <= 0.0) {
         return vec3<f32>(0.0);
     }
-    var f = diffuse_albedo(m, wo.z) * INV_PI;
+    return w / total;
+}
+
+// The generalised half vector of a refraction (Walter et al. 2007), facing +z, and the
+// Jacobian denominator (wi·h + wo·h/eta)²; w = 0 when wo, wi do not form a refraction.
+fn refraction_half_vector(wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec4<f32> {
+    var h = wi * eta + wo;
+    let len2 = dot(h, h);
+    if (len2 <= 0.0) {
+        return vec4<f32>(0.0);
+    }
+    h = h * inverseSqrt(len2);
+    h = select(h, -h, h.z < 0.0);
+    if (dot(h, wo) <= 0.0 || dot(h, wi) >= 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let d = dot(wi, h) + dot(wo, h) / eta;
+    return vec4<f32>(h, d * d);
+}
+
+// Refraction of wo through a surface with normal n (same side as wo); w = 0 under total
+// internal reflection.
+fn refract_dir(wo: vec3<f32>, n: vec3<f32>, eta: f32) -> vec4<f32> {
+    let cos_i = dot(n, wo);
+    let sin2_t = max(0.0, 1.0 - cos_i * cos_i) / (eta * eta);
+    if (sin2_t >= 1.0) {
+        return vec4<f32>(0.0);
+    }
+    let cos_t = sqrt(1.0 - sin2_t);
+    return vec4<f32>(-wo / eta + (cos_i / eta - cos_t) * n, 1.0);
+}
+
+// f(wo, wi) without the cosine; Dirac lobes are not included.
+fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec3<f32> {
     let alpha = m.roughness * m.roughness;
+    if (wo.z <= 0.0 || wi.z == 0.0) {
+        return vec3<f32>(0.0);
+    }
+    if (wi.z < 0.0) {
+        if (alpha < DELTA_ALPHA || m.transmission <= 0.0) {
+            return vec3<f32>(0.0);
+        }
+        let hd = refraction_half_vector(wo, wi, eta);
+        if (hd.w <= 0.0) {
+            return vec3<f32>(0.0);
+        }
+        let h = hd.xyz;
+        let f = fresnel_dielectric(dot(wo, h), eta);
+        let ft = ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) * (1.0 - f)
+            * abs(dot(wi, h) * dot(wo, h) / (wi.z * wo.z * hd.w)) / (eta * eta);
+        return (1.0 - m.metallic) * m.transmission * m.base_color * ft;
+    }
+    var f = diffuse_albedo(m, wo.z, eta) * INV_PI;
     if (alpha >= DELTA_ALPHA) {
         let h = normalize(wo + wi);
         let spec = ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) / (4.0 * wo.z * wi.z);
-        f += bsdf_fresnel(m, dot(wo, h)) * spec;
+        f += bsdf_fresnel(m, dot(wo, h), eta) * spec;
     }
     return f;
 }
 
-fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    if (wo.z <= 0.0 || wi.z <= 0.0) {
+fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> f32 {
+    if (wo.z <= 0.0 || wi.z == 0.0) {
         return 0.0;
     }
-    let ps = specular_probability(m, wo.z);
-    var pdf = (1.0 - ps) * cosine_hemisphere_pdf(wi.z);
+    let p = lobe_probabilities(m, wo.z, eta);
     let alpha = m.roughness * m.roughness;
-    if (alpha >= DELTA_ALPHA && ps > 0.0) {
-        pdf += ps * ggx_reflection_pdf(wo, normalize(wo + wi), alpha);
+    if (wi.z < 0.0) {
+        if (alpha < DELTA_ALPHA || p.z <= 0.0) {
+            return 0.0;
+        }
+        let hd = refraction_half_vector(wo, wi, eta);
+        if (hd.w <= 0.0) {
+            return 0.0;
+        }
+        let h = hd.xyz;
+        let d_wo = ggx_g1(wo, alpha) * ggx_d(h, alpha) * dot(wo, h) / wo.z;
+        return p.z * d_wo * abs(dot(wi, h)) / hd.w;
+    }
+    var pdf = p.y * cosine_hemisphere_pdf(wi.z);
+    if (alpha >= DELTA_ALPHA && p.x > 0.0) {
+        pdf += p.x * ggx_reflection_pdf(wo, normalize(wo + wi), alpha);
     }
     return pdf;
 }
 
-fn bsdf_sample(m: Material, wo: vec3<f32>, u: vec3<f32>) -> BsdfSample {
+fn bsdf_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample {
     let none = BsdfSample(vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(0.0), 0.0, false);
     if (wo.z <= 0.0) {
         return none;
     }
-    let ps = specular_probability(m, wo.z);
+    let p = lobe_probabilities(m, wo.z, eta);
     let alpha = m.roughness * m.roughness;
     var wi: vec3<f32>;
-    if (u.x < ps) {
+    if (u.x < p.x) {
         if (alpha < DELTA_ALPHA) {
             let mirror = vec3<f32>(-wo.x, -wo.y, wo.z);
-            return BsdfSample(mirror, bsdf_fresnel(m, wo.z) / ps, ps, true);
+            return BsdfSample(mirror, bsdf_fresnel(m, wo.z, eta) / p.x, p.x, true);
         }
         let h = ggx_sample_vndf(wo, alpha, u.yz);
         wi = 2.0 * dot(wo, h) * h - wo;
-    } else {
+        // A reflection below the horizon is a lost sample (pdf below counts transmission only).
+        if (wi.z <= 0.0) {
+            return none;
+        }
+    } else if (u.x < p.x + p.y) {
         wi = sample_cosine_hemisphere(u.yz);
+    } else {
+        if (p.z <= 0.0) {
+            return none;
+        }
+        var h = vec3<f32>(0.0, 0.0, 1.0);
+        if (alpha >= DELTA_ALPHA) {
+            h = ggx_sample_vndf(wo, alpha, u.yz);
+        }
+        let r = refract_dir(wo, h, eta);
+        if (r.w == 0.0) {
+            return none;
+        }
+        if (alpha < DELTA_ALPHA) {
+            let t = transmission_albedo(m, wo.z, eta) / (eta * eta);
+            return BsdfSample(r.xyz, t / p.z, p.z, true);
+        }
+        wi = r.xyz;
+        if (wi.z >= 0.0) {
+            return none;
+        }
     }
-    let pdf = bsdf_pdf(m, wo, wi);
-    if (wi.z <= 0.0 || pdf <= 0.0) {
+    let pdf = bsdf_pdf(m, wo, wi, eta);
+    if (wi.z == 0.0 || pdf <= 0.0) {
         return none;
     }
-    return BsdfSample(wi, bsdf_eval(m, wo, wi) * (wi.z / pdf), pdf, false);
+    return BsdfSample(wi, bsdf_eval(m, wo, wi, eta) * (abs(wi.z) / pdf), pdf, false);
 }

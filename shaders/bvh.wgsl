@@ -1,6 +1,8 @@
 // Ray–scene intersection: Möller–Trumbore triangles in a BVH2 walked with a small stack,
-// nearer child first. Twin: src/cpu/bvh.rs.
+// nearer child first; triangles with MASK or BLEND alpha are skipped where their alpha says
+// the surface is not there. Twin: src/cpu/bvh.rs.
 #include "bindings.wgsl"
+#include "material.wgsl"
 
 const NO_HIT: u32 = 0xffffffffu;
 const STACK_SIZE: u32 = 64u;
@@ -60,8 +62,9 @@ fn trace(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
         let node = nodes[index];
         if (node.count > 0u) {
             for (var i = node.index; i < node.index + node.count; i++) {
-                let r = intersect_triangle(ray, triangles[i]);
-                if (r.x < hit.t) {
+                let tri = triangles[i];
+                let r = intersect_triangle(ray, tri);
+                if (r.x < hit.t && ((tri.flags & TRI_ALPHA) == 0u || alpha_passes(i, r.y, r.z, ray))) {
                     hit = Hit(r.x, i, r.y, r.z);
                     if (any_hit) {
                         return hit;

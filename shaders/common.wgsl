@@ -26,11 +26,31 @@ struct Triangle {
 }
 
 const TRI_HAS_NORMALS: u32 = 1u;
+const TRI_HAS_TANGENTS: u32 = 2u;
+const TRI_ALPHA: u32 = 4u;
+const TRI_TANGENT_SIGN_SHIFT: u32 = 3u;
 
-struct Normals {
+// Per-triangle vertex attributes: octahedral normals and tangents, TEXCOORD_0.
+struct Attributes {
     n: vec3<u32>,
-    pad: u32,
+    t0: u32,
+    t12: vec2<u32>,
+    uv0: vec2<f32>,
+    uv1: vec2<f32>,
+    uv2: vec2<f32>,
 }
+
+// A material's texture: array layer (NO_TEXTURE: none), UV transform rows, wrap/sRGB bits.
+struct TextureRef {
+    row0: vec3<f32>,
+    layer: u32,
+    row1: vec3<f32>,
+    mode: u32,
+}
+
+const MAT_ALPHA_MASK: u32 = 1u;
+const MAT_ALPHA_BLEND: u32 = 2u;
+const MAT_DOUBLE_SIDED: u32 = 4u;
 
 struct Material {
     base_color: vec3<f32>,
@@ -40,6 +60,31 @@ struct Material {
     dielectric_f0: vec3<f32>,
     ior: f32,
     dielectric_f90: f32,
+    transmission: f32,
+    alpha: f32,
+    alpha_cutoff: f32,
+    // Absorption coefficient inside the volume (KHR_materials_volume).
+    attenuation: vec3<f32>,
+    flags: u32,
+    normal_scale: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
+    base_color_texture: TextureRef,
+    metallic_roughness_texture: TextureRef,
+    emissive_texture: TextureRef,
+    normal_texture: TextureRef,
+}
+
+// KHR_lights_punctual, four rows of the light-data buffer each.
+struct Punctual {
+    position: vec3<f32>,
+    kind: f32,
+    direction: vec3<f32>,
+    range: f32,
+    intensity: vec3<f32>,
+    cos_inner: f32,
+    cos_outer: f32,
     pad0: f32,
     pad1: f32,
     pad2: f32,
@@ -83,8 +128,9 @@ struct Params {
     focus_distance: f32,
     // First film row of this dispatch (the viewer renders a sample in bands of rows).
     row_offset: u32,
-    pad1: u32,
-    pad2: u32,
+    // Punctual lights: first row in the light-data buffer, and how many.
+    punctual_base: u32,
+    punctual_count: u32,
 }
 
 struct Ray {

@@ -9,24 +9,16 @@
 #include "lights.wgsl"
 #include "mis.wgsl"
 #include "film.wgsl"
+#include "material.wgsl"
 
-fn shading_normal(tri: Triangle, index: u32, u: f32, v: f32, ng: vec3<f32>) -> vec3<f32> {
-    if ((tri.flags & TRI_HAS_NORMALS) == 0u) {
-        return ng;
-    }
-    let packed = normals[index].n;
-    let n = (1.0 - u - v) * oct_decode(packed.x) + u * oct_decode(packed.y) + v * oct_decode(packed.z);
-    let len2 = dot(n, n);
-    return select(ng, n * inverseSqrt(len2), len2 > 0.0);
+// Do the geometric and the shading normal agree on which side `wi` leaves?
+fn same_side(wi: vec3<f32>, ng: vec3<f32>, wi_local: vec3<f32>) -> bool {
+    return (dot(wi, ng) > 0.0) == (wi_local.z > 0.0);
 }
 
-fn oct_decode(bits: u32) -> vec3<f32> {
-    let e = unpack2x16snorm(bits);
-    let z = 1.0 - abs(e.x) - abs(e.y);
-    let t = max(-z, 0.0);
-    let x = e.x + select(t, -t, e.x >= 0.0);
-    let y = e.y + select(t, -t, e.y >= 0.0);
-    return normalize(vec3<f32>(x, y, z));
+// The surface point moved off the surface to the side `wi` leaves through.
+fn spawn_point(point: vec3<f32>, ng: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    return offset_ray(point, select(-ng, ng, dot(wi, ng) > 0.0));
 }
 
 // Is the light sample visible from `origin`? Segments end just off the light's surface.
@@ -63,10 +55,15 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
             break;
         }
         let tri = triangles[hit.tri];
-        let m = materials[tri.material];
+        let uv = triangle_uv(hit.tri, hit.u, hit.v);
+        let m = material_at(materials[tri.material], uv);
         let point = tri.p0 + hit.u * tri.e1 + hit.v * tri.e2;
         let ng_raw = normalize(cross(tri.e1, tri.e2));
         let cos_hit = dot(ray.dir, ng_raw);
+        // Leaving a volume through its back face: Beer–Lambert over the segment inside.
+        if (cos_hit > 0.0 && max_component(m.attenuation) > 0.0) {
+            beta *= exp(-m.attenuation * hit.t);
+        }
 
         // Emission found by the BSDF sample of the previous vertex (or the camera ray).
         if (cos_hit < 0.0 && max_component(m.emission) > 0.0) {
@@ -84,41 +81,52 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
             break;
         }
 
-        // Surfaces are two-sided: face both normals towards the incoming ray.
+        // Surfaces are two-sided: face both normals towards the incoming ray. `eta` is the
+        // relative index of refraction for light crossing from the ray's side.
         let ng = select(ng_raw, -ng_raw, cos_hit > 0.0);
-        var ns = shading_normal(tri, hit.tri, hit.u, hit.v, ng_raw);
+        let eta = select(1.0 / m.ior, m.ior, cos_hit < 0.0);
+        var ns = shading_normal(tri, hit.tri, hit.u, hit.v, ng_raw, m, uv);
         ns = select(ns, -ns, dot(ns, ray.dir) > 0.0);
         let frame = frame_from_normal(ns);
         let wo = to_local(frame, -ray.dir);
-        let origin = offset_ray(point, ng);
 
         // Next-event estimation: one light sample.
         if (strategy != STRATEGY_BSDF && (params.light_count > 0u || params.env_select > 0.0)) {
             let u_light = vec3<f32>(rng_next(rng), rng_next2(rng));
             let ls = sample_light(point, u_light);
             if (ls.pdf > 0.0) {
-                let wi = ls.wi;
-                let wi_local = to_local(frame, wi);
-                let f = bsdf_eval(m, wo, wi_local);
-                if (dot(wi, ng) > 0.0 && max_component(f) > 0.0 && unoccluded(origin, ls)) {
+                let wi_local = to_local(frame, ls.wi);
+                let f = bsdf_eval(m, wo, wi_local, eta);
+                if (same_side(ls.wi, ng, wi_local) && max_component(f) > 0.0 && unoccluded(spawn_point(point, ng, ls.wi), ls)) {
                     var w = 1.0;
                     if (strategy != STRATEGY_LIGHT) {
-                        w = mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, wi_local));
+                        w = mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, wi_local, eta));
                     }
                     radiance += beta * f * abs(wi_local.z) * ls.radiance * (w / ls.pdf);
+                }
+            }
+        }
+        // Punctual lights: only next-event estimation can reach them, whatever the strategy.
+        if (params.punctual_count > 0u) {
+            let ls = sample_punctual(point, rng_next(rng));
+            if (ls.pdf > 0.0) {
+                let wi_local = to_local(frame, ls.wi);
+                let f = bsdf_eval(m, wo, wi_local, eta);
+                if (same_side(ls.wi, ng, wi_local) && max_component(f) > 0.0 && unoccluded(spawn_point(point, ng, ls.wi), ls)) {
+                    radiance += beta * f * abs(wi_local.z) * ls.radiance / ls.pdf;
                 }
             }
         }
 
         // BSDF sample: continues the path (and finds emitters for the MIS estimator).
         let u_bsdf = vec3<f32>(rng_next(rng), rng_next2(rng));
-        let bs = bsdf_sample(m, wo, u_bsdf);
+        let bs = bsdf_sample(m, wo, u_bsdf, eta);
         if (bs.pdf <= 0.0) {
             break;
         }
         let wi = from_local(frame, bs.wi);
-        // A reflection that the shading normal allows but the geometry does not would leak light.
-        if (dot(wi, ng) <= 0.0) {
+        // A direction that the shading normal allows but the geometry does not would leak light.
+        if (!same_side(wi, ng, bs.wi)) {
             break;
         }
         beta *= bs.weight;
@@ -127,7 +135,7 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
         }
         prev_pdf = bs.pdf;
         prev_delta = bs.delta;
-        ray = Ray(origin, wi);
+        ray = Ray(spawn_point(point, ng, wi), wi);
 
         if (depth >= params.rr_depth) {
             let q = min(max_component(beta), 0.95);

@@ -4,7 +4,7 @@
 //! (std430 layout, 16-byte aligned rows).
 
 use crate::accel;
-use crate::scene::{Material, Scene};
+use crate::scene::{AlphaMode, Material, PunctualKind, Scene, Texture, TextureRef};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
@@ -30,19 +30,48 @@ pub struct PackedTriangle {
     /// (the area-measure light pdf); 0 when it is not a light.
     pub light_pdf_area: f32,
     pub e2: [f32; 3],
-    /// Bit 0: has vertex normals (else shading normal = geometric normal).
+    /// TRI_* bits.
     pub flags: u32,
 }
 
+/// Has vertex normals (else the shading normal is the geometric normal).
 pub const TRI_HAS_NORMALS: u32 = 1;
+/// Has a tangent frame (its material has a normal map).
+pub const TRI_HAS_TANGENTS: u32 = 2;
+/// Its material's alpha (MASK or BLEND) decides whether a ray hits it.
+pub const TRI_ALPHA: u32 = 4;
+/// Bits 3, 4, 5: vertex 0, 1, 2's tangent has handedness −1.
+pub const TRI_TANGENT_SIGN_SHIFT: u32 = 3;
 
-/// Octahedron-encoded vertex normals (`pack2x16snorm`), one per vertex.
+/// Per-triangle vertex attributes: octahedron-encoded normals and tangents
+/// (`pack2x16snorm`) and TEXCOORD_0, one of each per vertex.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
-pub struct PackedNormals {
+pub struct PackedAttributes {
     pub n: [u32; 3],
-    pub pad: u32,
+    pub t0: u32,
+    pub t12: [u32; 2],
+    pub uv: [[f32; 2]; 3],
 }
+
+/// A material's texture: layer of the texture array (NO_TEXTURE: none), UV transform rows,
+/// and mode bits (wrap s in bits 0–1, wrap t in 2–3, sRGB-encoded in bit 4).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct PackedTextureRef {
+    pub row0: [f32; 3],
+    pub layer: u32,
+    pub row1: [f32; 3],
+    pub mode: u32,
+}
+
+pub const NO_TEXTURE: u32 = u32::MAX;
+pub const TEX_SRGB: u32 = 16;
+
+/// Material flags.
+pub const MAT_ALPHA_MASK: u32 = 1;
+pub const MAT_ALPHA_BLEND: u32 = 2;
+pub const MAT_DOUBLE_SIDED: u32 = 4;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
@@ -57,8 +86,45 @@ pub struct PackedMaterial {
     pub ior: f32,
     /// Grazing reflectance of the dielectric part (= specularFactor).
     pub dielectric_f90: f32,
+    /// Share of the non-metal part that refracts (KHR_materials_transmission).
+    pub transmission: f32,
+    /// baseColorFactor alpha, and the MASK cutoff.
+    pub alpha: f32,
+    pub alpha_cutoff: f32,
+    /// Absorption coefficient inside (KHR_materials_volume): −ln(color) / distance.
+    pub attenuation: [f32; 3],
+    /// MAT_* bits.
+    pub flags: u32,
+    pub normal_scale: f32,
+    pub pad: [f32; 3],
+    pub base_color_texture: PackedTextureRef,
+    pub metallic_roughness_texture: PackedTextureRef,
+    pub emissive_texture: PackedTextureRef,
+    pub normal_texture: PackedTextureRef,
+}
+
+/// A KHR_lights_punctual light as four rows of the light-data buffer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct PackedPunctual {
+    pub position: [f32; 3],
+    /// PUNCTUAL_* kind.
+    pub kind: f32,
+    pub direction: [f32; 3],
+    pub range: f32,
+    pub intensity: [f32; 3],
+    pub cos_inner: f32,
+    pub cos_outer: f32,
     pub pad: [f32; 3],
 }
+
+pub const PUNCTUAL_POINT: f32 = 0.0;
+pub const PUNCTUAL_SPOT: f32 = 1.0;
+pub const PUNCTUAL_DIRECTIONAL: f32 = 2.0;
+
+/// Largest side of a texture-array layer, and the budget of the whole array.
+pub const MAX_TEXTURE_LAYER_SIDE: u32 = 2048;
+pub const TEXTURE_BUDGET_BYTES: u64 = 256 << 20;
 
 /// One entry of the light alias table (Vose): pick entry `i` uniformly, keep it with
 /// probability `prob`, else take `alias`.
@@ -76,7 +142,7 @@ pub struct LightEntry {
 pub struct PackedScene {
     pub nodes: Vec<BvhNode>,
     pub triangles: Vec<PackedTriangle>,
-    pub normals: Vec<PackedNormals>,
+    pub attributes: Vec<PackedAttributes>,
     pub materials: Vec<PackedMaterial>,
     pub lights: Vec<LightEntry>,
     /// Original scene index of each packed triangle.
@@ -85,8 +151,15 @@ pub struct PackedScene {
     pub environment: Vec3,
     /// Environment map texels (rgb, conditional CDF of the row up to this texel), then one
     /// row per map row (marginal CDF up to this row, 0, 0, 0). One zeroed element when there
-    /// is no map.
+    /// is no map. Punctual lights follow, four rows each, from `punctual_base`.
     pub env: Vec<[f32; 4]>,
+    pub punctual_base: u32,
+    pub punctual_count: u32,
+    /// Texture array: `texture_layers` square layers of `texture_size`² RGBA8 texels (one
+    /// u32 each, R in the low byte), row-major, layer after layer. At least one layer.
+    pub texels: Vec<u32>,
+    pub texture_size: u32,
+    pub texture_layers: u32,
     pub env_width: u32,
     pub env_height: u32,
     /// Σ luminance × sin θ over all texels: the normaliser of the sampling pmf.
@@ -128,14 +201,34 @@ impl PackedScene {
             .map(|(t, &pdf)| {
                 let [p0, p1, p2] = t.positions;
                 let ng = t.cross().normalize_or_zero();
-                let flat = t.normals.iter().all(|n| n.dot(ng) > 0.99999);
+                let m = &scene.materials[t.material as usize];
+                let mut flags = 0;
+                if !t.normals.iter().all(|n| n.dot(ng) > 0.99999) {
+                    flags |= TRI_HAS_NORMALS;
+                }
+                if t.tangents.iter().all(|v| v.truncate() != Vec3::ZERO) {
+                    flags |= TRI_HAS_TANGENTS;
+                    for (k, v) in t.tangents.iter().enumerate() {
+                        if v.w < 0.0 {
+                            flags |= 1 << (TRI_TANGENT_SIGN_SHIFT + k as u32);
+                        }
+                    }
+                }
+                let cutout = match m.alpha_mode {
+                    AlphaMode::Opaque => false,
+                    AlphaMode::Mask(_) => true,
+                    AlphaMode::Blend => m.alpha < 1.0 || m.base_color_texture.is_some(),
+                };
+                if cutout {
+                    flags |= TRI_ALPHA;
+                }
                 PackedTriangle {
                     p0: p0.into(),
                     material: t.material,
                     e1: (p1 - p0).into(),
                     light_pdf_area: pdf,
                     e2: (p2 - p0).into(),
-                    flags: if flat { 0 } else { TRI_HAS_NORMALS },
+                    flags,
                 }
             })
             .collect();
@@ -144,25 +237,60 @@ impl PackedScene {
             // The empty BVH's leaf points at one zero-area triangle that no ray hits.
             triangles.push(PackedTriangle::zeroed());
         }
-        let mut normals: Vec<PackedNormals> =
-            ordered.iter().map(|t| PackedNormals { n: t.normals.map(oct_encode), pad: 0 }).collect();
-        normals.resize(triangles.len(), PackedNormals::zeroed());
-        let (env, env_width, env_height, env_total) = match &scene.environment_map {
+        let mut attributes: Vec<PackedAttributes> = ordered
+            .iter()
+            .map(|t| {
+                let tan = t.tangents.map(|v| oct_encode(v.truncate()));
+                PackedAttributes {
+                    n: t.normals.map(oct_encode),
+                    t0: tan[0],
+                    t12: [tan[1], tan[2]],
+                    uv: t.uvs.map(|v| v.into()),
+                }
+            })
+            .collect();
+        attributes.resize(triangles.len(), PackedAttributes::zeroed());
+        let (mut env, env_width, env_height, env_total) = match &scene.environment_map {
             Some(map) => pack_environment(map),
             None => (vec![[0.0; 4]], 0, 0, 0.0),
         };
+        let punctual_base = env.len() as u32;
+        for l in &scene.punctual_lights {
+            let (kind, cos_inner, cos_outer) = match l.kind {
+                PunctualKind::Point => (PUNCTUAL_POINT, -1.0, -1.0),
+                PunctualKind::Spot { cos_inner, cos_outer } => (PUNCTUAL_SPOT, cos_inner, cos_outer),
+                PunctualKind::Directional => (PUNCTUAL_DIRECTIONAL, -1.0, -1.0),
+            };
+            let p = PackedPunctual {
+                position: l.position.into(),
+                kind,
+                direction: l.direction.into(),
+                range: if l.range.is_finite() { l.range } else { 0.0 },
+                intensity: l.intensity.into(),
+                cos_inner,
+                cos_outer,
+                pad: [0.0; 3],
+            };
+            env.extend_from_slice(bytemuck::cast_slice::<PackedPunctual, [f32; 4]>(&[p]));
+        }
+        let (texels, texture_size, texture_layers) = pack_textures(&scene.textures);
         let bounds = scene.bounds();
         let extent = if bounds.is_empty() { 1.0 } else { bounds.diagonal().length() };
         PackedScene {
             nodes: bvh.nodes,
             triangles,
-            normals,
+            attributes,
             materials,
             lights,
             order: bvh.order,
             bvh_build_seconds: bvh.build_seconds,
             environment: scene.environment,
             env,
+            punctual_base,
+            punctual_count: scene.punctual_lights.len() as u32,
+            texels,
+            texture_size,
+            texture_layers,
             env_width,
             env_height,
             env_total,
@@ -204,7 +332,20 @@ pub fn luminance(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }
 
-fn pack_material(m: &Material) -> PackedMaterial {
+pub fn pack_material(m: &Material) -> PackedMaterial {
+    let (cutoff, mut flags) = match m.alpha_mode {
+        AlphaMode::Opaque => (0.0, 0),
+        AlphaMode::Mask(c) => (c, MAT_ALPHA_MASK),
+        AlphaMode::Blend => (0.0, MAT_ALPHA_BLEND),
+    };
+    if m.double_sided {
+        flags |= MAT_DOUBLE_SIDED;
+    }
+    let attenuation = if m.attenuation_distance.is_finite() {
+        m.attenuation_color.max(Vec3::splat(1e-6)).map(|c| -c.ln() / m.attenuation_distance)
+    } else {
+        Vec3::ZERO
+    };
     PackedMaterial {
         base_color: m.base_color.into(),
         metallic: m.metallic,
@@ -213,8 +354,65 @@ fn pack_material(m: &Material) -> PackedMaterial {
         dielectric_f0: dielectric_f0(m).into(),
         ior: m.ior,
         dielectric_f90: m.specular_factor,
+        transmission: m.transmission,
+        alpha: m.alpha,
+        alpha_cutoff: cutoff,
+        attenuation: attenuation.into(),
+        flags,
+        normal_scale: m.normal_scale,
         pad: [0.0; 3],
+        base_color_texture: pack_texture_ref(m.base_color_texture, true),
+        metallic_roughness_texture: pack_texture_ref(m.metallic_roughness_texture, false),
+        emissive_texture: pack_texture_ref(m.emissive_texture, true),
+        normal_texture: pack_texture_ref(m.normal_texture, false),
     }
+}
+
+fn pack_texture_ref(t: Option<TextureRef>, srgb: bool) -> PackedTextureRef {
+    match t {
+        None => PackedTextureRef { row0: [1.0, 0.0, 0.0], layer: NO_TEXTURE, row1: [0.0, 1.0, 0.0], mode: 0 },
+        Some(t) => PackedTextureRef {
+            row0: t.transform[0],
+            layer: t.texture,
+            row1: t.transform[1],
+            mode: t.wrap[0] as u32 | (t.wrap[1] as u32) << 2 | if srgb { TEX_SRGB } else { 0 },
+        },
+    }
+}
+
+/// The layer side for `textures`: the largest image side rounded up to a power of two, at
+/// most MAX_TEXTURE_LAYER_SIDE, halved until the array fits TEXTURE_BUDGET_BYTES.
+pub fn texture_layer_side(textures: &[Texture]) -> u32 {
+    let largest = textures.iter().map(|t| t.width.max(t.height)).max().unwrap_or(1);
+    let mut side = largest.next_power_of_two().min(MAX_TEXTURE_LAYER_SIDE);
+    while side > 64 && textures.len() as u64 * (side as u64).pow(2) * 4 > TEXTURE_BUDGET_BYTES {
+        side /= 2;
+    }
+    side
+}
+
+/// Every texture resampled (bilinear/triangle filter) to one square layer of a texture array:
+/// lavapipe has no binding arrays, and UVs are relative, so a layer can hold any image.
+fn pack_textures(textures: &[Texture]) -> (Vec<u32>, u32, u32) {
+    if textures.is_empty() {
+        return (vec![u32::MAX], 1, 1);
+    }
+    let side = texture_layer_side(textures);
+    use rayon::prelude::*;
+    let layers: Vec<Vec<u32>> = textures
+        .par_iter()
+        .map(|t| {
+            let image = image::RgbaImage::from_raw(t.width, t.height, t.rgba.clone())
+                .unwrap_or_else(|| image::RgbaImage::new(t.width.max(1), t.height.max(1)));
+            let image = if image.dimensions() == (side, side) {
+                image
+            } else {
+                image::imageops::resize(&image, side, side, image::imageops::FilterType::Triangle)
+            };
+            image.pixels().map(|p| u32::from_le_bytes(p.0)).collect()
+        })
+        .collect();
+    (layers.concat(), side, textures.len() as u32)
 }
 
 /// The dielectric F0 of glTF's metallic-roughness model with KHR_materials_specular/_ior.

@@ -38,7 +38,9 @@ pub struct Params {
     pub focus_distance: f32,
     /// First film row of this dispatch (the viewer renders a sample in bands of rows).
     pub row_offset: u32,
-    pub pad: [u32; 2],
+    /// Punctual lights: first row in `PackedScene::env`, and how many.
+    pub punctual_base: u32,
+    pub punctual_count: u32,
 }
 
 /// Russian roulette starts once a path has this many segments.
@@ -97,7 +99,8 @@ impl Params {
             aperture: 0.0,
             focus_distance: 1.0,
             row_offset: 0,
-            pad: [0; 2],
+            punctual_base: scene.punctual_base,
+            punctual_count: scene.punctual_count,
         }
     }
 }

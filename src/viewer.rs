@@ -276,7 +276,7 @@ impl Viewer {
                 (uv.y * self.settings.height as f32).max(0.0) as u32,
             );
             let ray = crate::cpu::camera::generate_ray(&params, pixel, glam::Vec2::splat(0.5), &mut 0);
-            let hit = crate::cpu::bvh::intersect_closest(&r.scene().nodes, &r.scene().triangles, &ray);
+            let hit = crate::cpu::bvh::intersect_closest(r.scene(), &ray);
             if hit.tri != crate::cpu::bvh::NO_HIT {
                 self.settings.focus_distance = Some(hit.t * ray.dir.dot(Vec3::from(params.cam_forward)));
                 self.status = format!("focus distance {:.4}", self.settings.focus_distance.unwrap_or(0.0));

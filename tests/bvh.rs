@@ -25,7 +25,7 @@ fn soup(count: usize, rng: &mut Lcg) -> Scene {
             let c = rng.v() * 10.0;
             let p = [c + rng.v() - 0.5, c + rng.v() - 0.5, c + rng.v() - 0.5];
             let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-            Triangle { positions: p, normals: [n; 3], material: 0 }
+            Triangle { positions: p, normals: [n; 3], material: 0, ..Default::default() }
         })
         .collect();
     Scene { triangles, materials: vec![Material::default()], ..Default::default() }
@@ -40,7 +40,7 @@ fn check(scene: &Scene, rays: usize, rng: &mut Lcg) {
         let origin = lo + rng.v() * size;
         let dir = (rng.v() * 2.0 - 1.0).normalize();
         let ray = Ray { origin, dir };
-        let bvh = intersect_closest(&packed.nodes, &packed.triangles, &ray);
+        let bvh = intersect_closest(&packed, &ray);
         let mut brute = (INF, NO_HIT);
         for (i, t) in packed.triangles.iter().enumerate() {
             let r = intersect_triangle(&ray, t);
@@ -56,9 +56,9 @@ fn check(scene: &Scene, rays: usize, rng: &mut Lcg) {
             let tri = &packed.triangles[bvh.tri as usize];
             assert_eq!(intersect_triangle(&ray, tri).x, bvh.t);
             // Any-hit agrees: blocked just beyond the hit, free just before it.
-            assert!(occluded(&packed.nodes, &packed.triangles, &ray, bvh.t * 1.0001));
+            assert!(occluded(&packed, &ray, bvh.t * 1.0001));
         } else {
-            assert!(!occluded(&packed.nodes, &packed.triangles, &ray, INF));
+            assert!(!occluded(&packed, &ray, INF));
         }
     }
     assert!(hits > rays / 20, "the test rays should hit something ({hits}/{rays})");
@@ -78,5 +78,5 @@ fn bvh_closest_hit_equals_brute_force() {
 fn bvh_of_an_empty_scene_misses() {
     let packed = PackedScene::new(&Scene::default());
     let ray = Ray { origin: Vec3::ZERO, dir: Vec3::Z };
-    assert_eq!(intersect_closest(&packed.nodes, &packed.triangles, &ray).tri, NO_HIT);
+    assert_eq!(intersect_closest(&packed, &ray).tri, NO_HIT);
 }

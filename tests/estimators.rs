@@ -66,7 +66,7 @@ fn plate_masks() -> Vec<Vec<usize>> {
     for y in 0..64 {
         for x in 0..64 {
             let ray = veach::cpu::camera::generate_ray(&params, UVec2::new(x, y), Vec2::splat(0.5), &mut 0);
-            let hit = intersect_closest(&packed.nodes, &packed.triangles, &ray);
+            let hit = intersect_closest(&packed, &ray);
             if hit.tri != NO_HIT {
                 let m = packed.triangles[hit.tri as usize].material as usize;
                 let name = scene.materials.get(m).map(|_| m).unwrap_or(0);

@@ -1,9 +1,10 @@
-//! Twin of `shaders/bsdf.wgsl`: glTF metallic-roughness (GGX specular over Lambert).
+//! Twin of `shaders/bsdf.wgsl`: glTF metallic-roughness (GGX specular over Lambert and GGX
+//! transmission).
 
-use super::microfacet::{ggx_d, ggx_g2, ggx_reflection_pdf, ggx_sample_vndf};
+use super::microfacet::{ggx_d, ggx_g1, ggx_g2, ggx_reflection_pdf, ggx_sample_vndf};
 use super::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::packed::{PackedMaterial, luminance};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::FRAC_1_PI;
 
 pub const DELTA_ALPHA: f32 = 1e-4;
@@ -22,73 +23,176 @@ pub fn fresnel_schlick(f0: Vec3, f90: Vec3, cos_theta: f32) -> Vec3 {
     f0 + (f90 - f0) * (m2 * m2 * m)
 }
 
-pub fn bsdf_fresnel(m: &PackedMaterial, cos_theta: f32) -> Vec3 {
-    let dielectric = fresnel_schlick(m.dielectric_f0.into(), Vec3::splat(m.dielectric_f90), cos_theta);
-    let metal = fresnel_schlick(m.base_color.into(), Vec3::ONE, cos_theta);
-    dielectric.lerp(metal, m.metallic)
-}
-
-pub fn diffuse_albedo(m: &PackedMaterial, cos_o: f32) -> Vec3 {
-    let f = fresnel_schlick(m.dielectric_f0.into(), Vec3::splat(m.dielectric_f90), cos_o);
-    (1.0 - m.metallic) * Vec3::from(m.base_color) * (Vec3::ONE - f)
-}
-
-pub fn specular_probability(m: &PackedMaterial, cos_o: f32) -> f32 {
-    let ws = luminance(bsdf_fresnel(m, cos_o));
-    let wd = luminance(diffuse_albedo(m, cos_o));
-    if ws + wd <= 0.0 {
-        return 0.0;
+pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let c = cos_i.clamp(0.0, 1.0);
+    let sin2_t = (1.0 - c * c) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
     }
-    ws / (ws + wd)
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let r_parl = (eta * c - cos_t) / (eta * c + cos_t);
+    let r_perp = (c - eta * cos_t) / (c + eta * cos_t);
+    0.5 * (r_parl * r_parl + r_perp * r_perp)
 }
 
-pub fn bsdf_eval(m: &PackedMaterial, wo: Vec3, wi: Vec3) -> Vec3 {
-    if wo.z <= 0.0 || wi.z <= 0.0 {
+pub fn dielectric_fresnel(m: &PackedMaterial, cos_theta: f32, eta: f32) -> Vec3 {
+    if m.transmission > 0.0 {
+        return Vec3::splat(fresnel_dielectric(cos_theta, eta));
+    }
+    fresnel_schlick(m.dielectric_f0.into(), Vec3::splat(m.dielectric_f90), cos_theta)
+}
+
+pub fn bsdf_fresnel(m: &PackedMaterial, cos_theta: f32, eta: f32) -> Vec3 {
+    let metal = fresnel_schlick(m.base_color.into(), Vec3::ONE, cos_theta);
+    dielectric_fresnel(m, cos_theta, eta).lerp(metal, m.metallic)
+}
+
+pub fn diffuse_albedo(m: &PackedMaterial, cos_o: f32, eta: f32) -> Vec3 {
+    let f = dielectric_fresnel(m, cos_o, eta);
+    (1.0 - m.metallic) * (1.0 - m.transmission) * Vec3::from(m.base_color) * (Vec3::ONE - f)
+}
+
+pub fn transmission_albedo(m: &PackedMaterial, cos_o: f32, eta: f32) -> Vec3 {
+    let f = dielectric_fresnel(m, cos_o, eta);
+    (1.0 - m.metallic) * m.transmission * Vec3::from(m.base_color) * (Vec3::ONE - f)
+}
+
+pub fn lobe_probabilities(m: &PackedMaterial, cos_o: f32, eta: f32) -> Vec3 {
+    let mut wt = luminance(transmission_albedo(m, cos_o, eta));
+    if m.roughness * m.roughness >= DELTA_ALPHA {
+        wt = wt.max(0.1 * (1.0 - m.metallic) * m.transmission * luminance(m.base_color.into()));
+    }
+    let w = Vec3::new(luminance(bsdf_fresnel(m, cos_o, eta)), luminance(diffuse_albedo(m, cos_o, eta)), wt);
+    let total = w.x + w.y + w.z;
+    if total <= 0.0 {
         return Vec3::ZERO;
     }
-    let mut f = diffuse_albedo(m, wo.z) * FRAC_1_PI;
+    w / total
+}
+
+pub fn refraction_half_vector(wo: Vec3, wi: Vec3, eta: f32) -> Vec4 {
+    let h = wi * eta + wo;
+    let len2 = h.dot(h);
+    if len2 <= 0.0 {
+        return Vec4::ZERO;
+    }
+    let mut h = h / len2.sqrt();
+    if h.z < 0.0 {
+        h = -h;
+    }
+    if h.dot(wo) <= 0.0 || h.dot(wi) >= 0.0 {
+        return Vec4::ZERO;
+    }
+    let d = wi.dot(h) + wo.dot(h) / eta;
+    h.extend(d * d)
+}
+
+pub fn refract_dir(wo: Vec3, n: Vec3, eta: f32) -> Vec4 {
+    let cos_i = n.dot(wo);
+    let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return Vec4::ZERO;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    (-wo / eta + (cos_i / eta - cos_t) * n).extend(1.0)
+}
+
+pub fn bsdf_eval(m: &PackedMaterial, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
     let alpha = m.roughness * m.roughness;
+    if wo.z <= 0.0 || wi.z == 0.0 {
+        return Vec3::ZERO;
+    }
+    if wi.z < 0.0 {
+        if alpha < DELTA_ALPHA || m.transmission <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let hd = refraction_half_vector(wo, wi, eta);
+        if hd.w <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let h = hd.truncate();
+        let f = fresnel_dielectric(wo.dot(h), eta);
+        let ft =
+            ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) * (1.0 - f) * (wi.dot(h) * wo.dot(h) / (wi.z * wo.z * hd.w)).abs()
+                / (eta * eta);
+        return (1.0 - m.metallic) * m.transmission * Vec3::from(m.base_color) * ft;
+    }
+    let mut f = diffuse_albedo(m, wo.z, eta) * FRAC_1_PI;
     if alpha >= DELTA_ALPHA {
         let h = (wo + wi).normalize();
         let spec = ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) / (4.0 * wo.z * wi.z);
-        f += bsdf_fresnel(m, wo.dot(h)) * spec;
+        f += bsdf_fresnel(m, wo.dot(h), eta) * spec;
     }
     f
 }
 
-pub fn bsdf_pdf(m: &PackedMaterial, wo: Vec3, wi: Vec3) -> f32 {
-    if wo.z <= 0.0 || wi.z <= 0.0 {
+pub fn bsdf_pdf(m: &PackedMaterial, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+    if wo.z <= 0.0 || wi.z == 0.0 {
         return 0.0;
     }
-    let ps = specular_probability(m, wo.z);
-    let mut pdf = (1.0 - ps) * cosine_hemisphere_pdf(wi.z);
+    let p = lobe_probabilities(m, wo.z, eta);
     let alpha = m.roughness * m.roughness;
-    if alpha >= DELTA_ALPHA && ps > 0.0 {
-        pdf += ps * ggx_reflection_pdf(wo, (wo + wi).normalize(), alpha);
+    if wi.z < 0.0 {
+        if alpha < DELTA_ALPHA || p.z <= 0.0 {
+            return 0.0;
+        }
+        let hd = refraction_half_vector(wo, wi, eta);
+        if hd.w <= 0.0 {
+            return 0.0;
+        }
+        let h = hd.truncate();
+        let d_wo = ggx_g1(wo, alpha) * ggx_d(h, alpha) * wo.dot(h) / wo.z;
+        return p.z * d_wo * wi.dot(h).abs() / hd.w;
+    }
+    let mut pdf = p.y * cosine_hemisphere_pdf(wi.z);
+    if alpha >= DELTA_ALPHA && p.x > 0.0 {
+        pdf += p.x * ggx_reflection_pdf(wo, (wo + wi).normalize(), alpha);
     }
     pdf
 }
 
-pub fn bsdf_sample(m: &PackedMaterial, wo: Vec3, u: Vec3) -> BsdfSample {
+pub fn bsdf_sample(m: &PackedMaterial, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
     let none = BsdfSample { wi: Vec3::Z, weight: Vec3::ZERO, pdf: 0.0, delta: false };
     if wo.z <= 0.0 {
         return none;
     }
-    let ps = specular_probability(m, wo.z);
+    let p = lobe_probabilities(m, wo.z, eta);
     let alpha = m.roughness * m.roughness;
-    let wi = if u.x < ps {
+    let wi = if u.x < p.x {
         if alpha < DELTA_ALPHA {
             let mirror = Vec3::new(-wo.x, -wo.y, wo.z);
-            return BsdfSample { wi: mirror, weight: bsdf_fresnel(m, wo.z) / ps, pdf: ps, delta: true };
+            return BsdfSample { wi: mirror, weight: bsdf_fresnel(m, wo.z, eta) / p.x, pdf: p.x, delta: true };
         }
         let h = ggx_sample_vndf(wo, alpha, Vec2::new(u.y, u.z));
-        2.0 * wo.dot(h) * h - wo
-    } else {
+        let wi = 2.0 * wo.dot(h) * h - wo;
+        if wi.z <= 0.0 {
+            return none;
+        }
+        wi
+    } else if u.x < p.x + p.y {
         sample_cosine_hemisphere(Vec2::new(u.y, u.z))
+    } else {
+        if p.z <= 0.0 {
+            return none;
+        }
+        let h = if alpha >= DELTA_ALPHA { ggx_sample_vndf(wo, alpha, Vec2::new(u.y, u.z)) } else { Vec3::Z };
+        let r = refract_dir(wo, h, eta);
+        if r.w == 0.0 {
+            return none;
+        }
+        if alpha < DELTA_ALPHA {
+            let t = transmission_albedo(m, wo.z, eta) / (eta * eta);
+            return BsdfSample { wi: r.truncate(), weight: t / p.z, pdf: p.z, delta: true };
+        }
+        let wi = r.truncate();
+        if wi.z >= 0.0 {
+            return none;
+        }
+        wi
     };
-    let pdf = bsdf_pdf(m, wo, wi);
-    if wi.z <= 0.0 || pdf <= 0.0 {
+    let pdf = bsdf_pdf(m, wo, wi, eta);
+    if wi.z == 0.0 || pdf <= 0.0 {
         return none;
     }
-    BsdfSample { wi, weight: bsdf_eval(m, wo, wi) * (wi.z / pdf), pdf, delta: false }
+    BsdfSample { wi, weight: bsdf_eval(m, wo, wi, eta) * (wi.z.abs() / pdf), pdf, delta: false }
 }

@@ -1,6 +1,7 @@
 //! Twin of `shaders/bvh.wgsl`: the same traversal over the same nodes.
 
-use crate::packed::{BvhNode, PackedTriangle};
+use super::material::alpha_passes;
+use crate::packed::{BvhNode, PackedScene, PackedTriangle, TRI_ALPHA};
 use glam::{IVec3, Vec3};
 
 pub const NO_HIT: u32 = u32::MAX;
@@ -53,7 +54,8 @@ pub fn intersect_node(node: &BvhNode, origin: Vec3, inv_dir: Vec3, t_max: f32) -
     if t_enter <= t_exit { t_enter } else { INF }
 }
 
-pub fn trace(nodes: &[BvhNode], triangles: &[PackedTriangle], ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
+pub fn trace(scene: &PackedScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
+    let (nodes, triangles): (&[BvhNode], &[PackedTriangle]) = (&scene.nodes, &scene.triangles);
     let mut hit = Hit { t: t_max, tri: NO_HIT, u: 0.0, v: 0.0 };
     let inv_dir = Vec3::ONE / ray.dir;
     let mut stack = [0u32; STACK_SIZE];
@@ -66,8 +68,9 @@ pub fn trace(nodes: &[BvhNode], triangles: &[PackedTriangle], ray: &Ray, t_max: 
         let node = &nodes[index];
         if node.count > 0 {
             for i in node.index..node.index + node.count {
-                let r = intersect_triangle(ray, &triangles[i as usize]);
-                if r.x < hit.t {
+                let tri = &triangles[i as usize];
+                let r = intersect_triangle(ray, tri);
+                if r.x < hit.t && (tri.flags & TRI_ALPHA == 0 || alpha_passes(scene, i, r.y, r.z, ray)) {
                     hit = Hit { t: r.x, tri: i, u: r.y, v: r.z };
                     if any_hit {
                         return hit;
@@ -105,12 +108,12 @@ pub fn trace(nodes: &[BvhNode], triangles: &[PackedTriangle], ray: &Ray, t_max: 
     hit
 }
 
-pub fn intersect_closest(nodes: &[BvhNode], triangles: &[PackedTriangle], ray: &Ray) -> Hit {
-    trace(nodes, triangles, ray, INF, false)
+pub fn intersect_closest(scene: &PackedScene, ray: &Ray) -> Hit {
+    trace(scene, ray, INF, false)
 }
 
-pub fn occluded(nodes: &[BvhNode], triangles: &[PackedTriangle], ray: &Ray, t_max: f32) -> bool {
-    trace(nodes, triangles, ray, t_max, true).tri != NO_HIT
+pub fn occluded(scene: &PackedScene, ray: &Ray, t_max: f32) -> bool {
+    trace(scene, ray, t_max, true).tri != NO_HIT
 }
 
 pub fn offset_ray(p: Vec3, n: Vec3) -> Vec3 {

@@ -25,6 +25,6 @@ pub fn generate_ray(params: &Params, pixel: UVec2, u: Vec2, rng: &mut u32) -> Ra
 /// The distance in focus when only an aperture is given: what the image centre sees.
 pub fn autofocus(scene: &crate::packed::PackedScene, params: &Params) -> f32 {
     let ray = Ray { origin: params.cam_position.into(), dir: Vec3::from(params.cam_forward).normalize() };
-    let hit = super::bvh::intersect_closest(&scene.nodes, &scene.triangles, &ray);
+    let hit = super::bvh::intersect_closest(scene, &ray);
     if hit.tri != super::bvh::NO_HIT { hit.t } else { 0.5 * scene.extent }
 }

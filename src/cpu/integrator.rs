@@ -5,35 +5,34 @@ use super::bvh::{INF, NO_HIT, Ray, intersect_closest, occluded, offset_ray};
 use super::camera::generate_ray;
 use super::environment::{environment_pdf, environment_radiance};
 use super::frame::{frame_from_normal, from_local, to_local};
-use super::lights::{LightSample, light_pdf, sample_light};
+use super::lights::{LightSample, light_pdf, sample_light, sample_punctual};
+use super::material::{material_at, shading_normal, triangle_uv};
 use super::mis::mis_weight;
 use super::rng::{rng_init, rng_next, rng_next2};
 use crate::Strategy;
-use crate::packed::{PackedScene, PackedTriangle, TRI_HAS_NORMALS, oct_decode};
+use crate::packed::PackedScene;
 use crate::params::Params;
 use glam::{UVec2, Vec3};
 
-fn shading_normal(scene: &PackedScene, tri: &PackedTriangle, index: u32, u: f32, v: f32, ng: Vec3) -> Vec3 {
-    if tri.flags & TRI_HAS_NORMALS == 0 {
-        return ng;
-    }
-    let packed = scene.normals[index as usize].n;
-    let n = (1.0 - u - v) * oct_decode(packed[0]) + u * oct_decode(packed[1]) + v * oct_decode(packed[2]);
-    let len2 = n.dot(n);
-    if len2 > 0.0 { n / len2.sqrt() } else { ng }
+fn same_side(wi: Vec3, ng: Vec3, wi_local: Vec3) -> bool {
+    (wi.dot(ng) > 0.0) == (wi_local.z > 0.0)
+}
+
+fn spawn_point(point: Vec3, ng: Vec3, wi: Vec3) -> Vec3 {
+    offset_ray(point, if wi.dot(ng) > 0.0 { ng } else { -ng })
 }
 
 fn unoccluded(scene: &PackedScene, origin: Vec3, ls: &LightSample) -> bool {
     if ls.dist == INF {
-        return !occluded(&scene.nodes, &scene.triangles, &Ray { origin, dir: ls.wi }, INF);
+        return !occluded(scene, &Ray { origin, dir: ls.wi }, INF);
     }
     let target = offset_ray(ls.point, ls.normal);
-    !occluded(&scene.nodes, &scene.triangles, &Ray { origin, dir: target - origin }, 1.0)
+    !occluded(scene, &Ray { origin, dir: target - origin }, 1.0)
 }
 
 pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) -> Vec3 {
     let strategy = Strategy::from_u32(params.strategy);
-    let (nodes, tris) = (&scene.nodes[..], &scene.triangles[..]);
+    let tris = &scene.triangles[..];
     let mut radiance = Vec3::ZERO;
     let mut beta = Vec3::ONE;
     let mut ray = camera_ray;
@@ -41,7 +40,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
     let mut prev_pdf = 0.0f32;
     let mut prev_delta = true;
     loop {
-        let hit = intersect_closest(nodes, tris, &ray);
+        let hit = intersect_closest(scene, &ray);
         depth += 1;
         if hit.tri == NO_HIT {
             let mut w = 1.0;
@@ -56,11 +55,16 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
             break;
         }
         let tri = &tris[hit.tri as usize];
-        let m = &scene.materials[tri.material as usize];
+        let uv = triangle_uv(scene, hit.tri, hit.u, hit.v);
+        let m = &material_at(scene, &scene.materials[tri.material as usize], uv);
         let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
         let point = Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2;
         let ng_raw = e1.cross(e2).normalize();
         let cos_hit = ray.dir.dot(ng_raw);
+        let attenuation = Vec3::from(m.attenuation);
+        if cos_hit > 0.0 && attenuation.max_element() > 0.0 {
+            beta *= (-attenuation * hit.t).exp();
+        }
         let emission = Vec3::from(m.emission);
 
         if cos_hit < 0.0 && emission.max_element() > 0.0 {
@@ -79,41 +83,56 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
         }
 
         let ng = if cos_hit > 0.0 { -ng_raw } else { ng_raw };
-        let mut ns = shading_normal(scene, tri, hit.tri, hit.u, hit.v, ng_raw);
+        let eta = if cos_hit < 0.0 { m.ior } else { 1.0 / m.ior };
+        let mut ns = shading_normal(scene, tri, hit.tri, hit.u, hit.v, ng_raw, m, uv);
         if ns.dot(ray.dir) > 0.0 {
             ns = -ns;
         }
         let frame = frame_from_normal(ns);
         let wo = to_local(&frame, -ray.dir);
-        let origin = offset_ray(point, ng);
 
         if strategy != Strategy::Bsdf && (params.light_count > 0 || params.env_select > 0.0) {
             let u0 = rng_next(rng);
             let u12 = rng_next2(rng);
             let ls = sample_light(scene, params, point, Vec3::new(u0, u12.x, u12.y));
             if ls.pdf > 0.0 {
-                let wi = ls.wi;
-                let wi_local = to_local(&frame, wi);
-                let f = bsdf_eval(m, wo, wi_local);
-                if wi.dot(ng) > 0.0 && f.max_element() > 0.0 && unoccluded(scene, origin, &ls) {
+                let wi_local = to_local(&frame, ls.wi);
+                let f = bsdf_eval(m, wo, wi_local, eta);
+                if same_side(ls.wi, ng, wi_local)
+                    && f.max_element() > 0.0
+                    && unoccluded(scene, spawn_point(point, ng, ls.wi), &ls)
+                {
                     let w = if strategy == Strategy::Light {
                         1.0
                     } else {
-                        mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, wi_local))
+                        mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, wi_local, eta))
                     };
                     radiance += beta * f * wi_local.z.abs() * ls.radiance * (w / ls.pdf);
+                }
+            }
+        }
+        if params.punctual_count > 0 {
+            let ls = sample_punctual(scene, params, point, rng_next(rng));
+            if ls.pdf > 0.0 {
+                let wi_local = to_local(&frame, ls.wi);
+                let f = bsdf_eval(m, wo, wi_local, eta);
+                if same_side(ls.wi, ng, wi_local)
+                    && f.max_element() > 0.0
+                    && unoccluded(scene, spawn_point(point, ng, ls.wi), &ls)
+                {
+                    radiance += beta * f * wi_local.z.abs() * ls.radiance / ls.pdf;
                 }
             }
         }
 
         let u0 = rng_next(rng);
         let u12 = rng_next2(rng);
-        let bs = bsdf_sample(m, wo, Vec3::new(u0, u12.x, u12.y));
+        let bs = bsdf_sample(m, wo, Vec3::new(u0, u12.x, u12.y), eta);
         if bs.pdf <= 0.0 {
             break;
         }
         let wi = from_local(&frame, bs.wi);
-        if wi.dot(ng) <= 0.0 {
+        if !same_side(wi, ng, bs.wi) {
             break;
         }
         beta *= bs.weight;
@@ -122,7 +141,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
         }
         prev_pdf = bs.pdf;
         prev_delta = bs.delta;
-        ray = Ray { origin, dir: wi };
+        ray = Ray { origin: spawn_point(point, ng, wi), dir: wi };
 
         if depth >= params.rr_depth {
             let q = beta.max_element().min(0.95);

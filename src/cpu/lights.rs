@@ -2,8 +2,9 @@
 
 use super::bvh::INF;
 use super::environment::{environment_pdf, environment_radiance, sample_environment};
+use super::material::{material_at, triangle_uv};
 use super::sampling::sample_uniform_triangle;
-use crate::packed::{PackedScene, PackedTriangle};
+use crate::packed::{NO_TEXTURE, PUNCTUAL_POINT, PUNCTUAL_SPOT, PackedPunctual, PackedScene, PackedTriangle};
 use crate::params::Params;
 use glam::{Vec2, Vec3};
 
@@ -47,7 +48,12 @@ pub fn sample_light(scene: &PackedScene, params: &Params, ref_point: Vec3, u: Ve
     let dist = dist2.sqrt();
     let wi = to_light / dist;
     let cos_light = -wi.dot(normal);
-    let radiance = scene.materials[tri.material as usize].emission.into();
+    let m = &scene.materials[tri.material as usize];
+    let radiance = if m.emissive_texture.layer != NO_TEXTURE {
+        material_at(scene, m, triangle_uv(scene, entry.triangle, b.x, b.y)).emission.into()
+    } else {
+        m.emission.into()
+    };
     if cos_light <= 0.0 || dist2 <= 0.0 {
         return LightSample { wi, dist, point, normal, radiance, pdf: 0.0 };
     }
@@ -56,4 +62,40 @@ pub fn sample_light(scene: &PackedScene, params: &Params, ref_point: Vec3, u: Ve
 
 pub fn light_pdf(params: &Params, tri: &PackedTriangle, dist2: f32, cos_light: f32) -> f32 {
     (1.0 - params.env_select) * tri.light_pdf_area * dist2 / cos_light.abs()
+}
+
+pub fn punctual_light(scene: &PackedScene, params: &Params, index: u32) -> PackedPunctual {
+    let base = (params.punctual_base + 4 * index) as usize;
+    bytemuck::cast_slice::<[f32; 4], PackedPunctual>(&scene.env[base..base + 4])[0]
+}
+
+pub fn sample_punctual(scene: &PackedScene, params: &Params, ref_point: Vec3, u: f32) -> LightSample {
+    let n = params.punctual_count;
+    let index = ((u * n as f32) as u32).min(n - 1);
+    let l = punctual_light(scene, params, index);
+    let pdf = 1.0 / n as f32;
+    let (position, direction, intensity) = (Vec3::from(l.position), Vec3::from(l.direction), Vec3::from(l.intensity));
+    if l.kind != PUNCTUAL_POINT && l.kind != PUNCTUAL_SPOT {
+        let wi = -direction;
+        return LightSample { wi, dist: INF, point: ref_point, normal: direction, radiance: intensity, pdf };
+    }
+    let to_light = position - ref_point;
+    let dist2 = to_light.dot(to_light);
+    let dist = dist2.sqrt();
+    let wi = to_light / dist;
+    let mut scale = 1.0 / dist2;
+    if l.range > 0.0 {
+        let x = dist / l.range;
+        let window = (1.0 - x * x * x * x).clamp(0.0, 1.0);
+        scale *= window * window;
+    }
+    if l.kind == PUNCTUAL_SPOT {
+        let cos_axis = (-wi).dot(direction);
+        let t = ((cos_axis - l.cos_outer) / (l.cos_inner - l.cos_outer).max(1e-4)).clamp(0.0, 1.0);
+        scale *= t * t;
+    }
+    if dist2 <= 0.0 || scale <= 0.0 {
+        return LightSample { wi, dist, point: position, normal: -wi, radiance: Vec3::ZERO, pdf: 0.0 };
+    }
+    LightSample { wi, dist, point: position, normal: -wi, radiance: intensity * scale, pdf }
 }

@@ -10,9 +10,11 @@ pub mod environment;
 pub mod frame;
 pub mod integrator;
 pub mod lights;
+pub mod material;
 pub mod microfacet;
 pub mod mis;
 pub mod rng;
 pub mod sampling;
+pub mod texture;
 
 pub use integrator::render_sample;

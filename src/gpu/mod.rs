@@ -109,6 +109,7 @@ pub struct GpuRenderer {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     scene: [wgpu::Buffer; 6],
+    textures: wgpu::TextureView,
     bind_group: wgpu::BindGroup,
     params_buf: wgpu::Buffer,
     film_buf: wgpu::Buffer,
@@ -144,11 +145,12 @@ impl GpuRenderer {
         let scene_buffers = [
             storage("bvh nodes", bytemuck::cast_slice(&scene.nodes))?,
             storage("triangles", bytemuck::cast_slice(&scene.triangles))?,
-            storage("normals", bytemuck::cast_slice(&scene.normals))?,
+            storage("vertex attributes", bytemuck::cast_slice(&scene.attributes))?,
             storage("materials", bytemuck::cast_slice(&scene.materials))?,
             storage("lights", bytemuck::cast_slice(&scene.lights))?,
-            storage("environment", bytemuck::cast_slice(&scene.env))?,
+            storage("light data", bytemuck::cast_slice(&scene.env))?,
         ];
+        let (textures, texture_bytes) = Self::texture_array(&ctx, scene)?;
         // One Params slot per dispatch of a batch, each at an aligned offset.
         let params_size = std::mem::size_of::<Params>() as u64;
         let stride = params_size.next_multiple_of(limits.min_storage_buffer_offset_alignment as u64);
@@ -193,6 +195,16 @@ impl GpuRenderer {
                 storage_entry(5, true),
                 storage_entry(6, false),
                 storage_entry(7, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 8,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -208,14 +220,17 @@ impl GpuRenderer {
             compilation_options: Default::default(),
             cache: None,
         });
-        let (film_buf, readback, bind_group) = Self::film(&ctx, &layout, &scene_buffers, &params_buf, params)?;
-        let gpu_bytes = scene_buffers.iter().chain([&film_buf, &params_buf]).map(|b| b.size()).sum::<u64>();
+        let (film_buf, readback, bind_group) =
+            Self::film(&ctx, &layout, &scene_buffers, &textures, &params_buf, params)?;
+        let gpu_bytes =
+            scene_buffers.iter().chain([&film_buf, &params_buf]).map(|b| b.size()).sum::<u64>() + texture_bytes;
         ctx.check()?;
         Ok(GpuRenderer {
             ctx,
             pipeline,
             layout,
             scene: scene_buffers,
+            textures,
             bind_group,
             params_buf,
             film_buf,
@@ -226,11 +241,45 @@ impl GpuRenderer {
         })
     }
 
+    /// The scene's images as one texture array (RGBA8, one square layer per image).
+    fn texture_array(ctx: &GpuContext, scene: &PackedScene) -> Result<(wgpu::TextureView, u64), Error> {
+        let limits = ctx.device.limits();
+        let (side, layers) = (scene.texture_size, scene.texture_layers);
+        if side > limits.max_texture_dimension_2d || layers > limits.max_texture_array_layers {
+            return Err(Error::Limit(format!(
+                "{layers} textures of {side}² texels exceed the device's texture arrays \
+                 (max_texture_dimension_2d = {}, max_texture_array_layers = {})",
+                limits.max_texture_dimension_2d, limits.max_texture_array_layers
+            )));
+        }
+        let texture = ctx.device.create_texture_with_data(
+            &ctx.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("textures"),
+                size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: layers },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba8Unorm,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(&scene.texels),
+        );
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        Ok((view, scene.texels.len() as u64 * 4))
+    }
+
     /// A zeroed film for `params`' window, its readback buffer and the bind group using it.
     fn film(
         ctx: &GpuContext,
         layout: &wgpu::BindGroupLayout,
         scene: &[wgpu::Buffer; 6],
+        textures: &wgpu::TextureView,
         params_buf: &wgpu::Buffer,
         params: Params,
     ) -> Result<(wgpu::Buffer, wgpu::Buffer, wgpu::BindGroup), Error> {
@@ -271,6 +320,7 @@ impl GpuRenderer {
                 entry(5, &scene[4]),
                 entry(6, &film_buf),
                 entry(7, &scene[5]),
+                wgpu::BindGroupEntry { binding: 8, resource: wgpu::BindingResource::TextureView(textures) },
             ],
         });
         Ok((film_buf, readback, bind_group))
@@ -280,7 +330,7 @@ impl GpuRenderer {
     pub fn reset(&mut self, params: Params) -> Result<(), Error> {
         if (params.film_width, params.film_height) != (self.params.film_width, self.params.film_height) {
             let (film, readback, bind_group) =
-                Self::film(&self.ctx, &self.layout, &self.scene, &self.params_buf, params)?;
+                Self::film(&self.ctx, &self.layout, &self.scene, &self.textures, &self.params_buf, params)?;
             (self.film_buf, self.readback, self.bind_group) = (film, readback, bind_group);
         } else {
             let mut encoder = self.ctx.device.create_command_encoder(&Default::default());

@@ -9,6 +9,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("sampling.wgsl", include_str!("../../shaders/sampling.wgsl")),
     ("frame.wgsl", include_str!("../../shaders/frame.wgsl")),
     ("mis.wgsl", include_str!("../../shaders/mis.wgsl")),
+    ("texture.wgsl", include_str!("../../shaders/texture.wgsl")),
+    ("material.wgsl", include_str!("../../shaders/material.wgsl")),
     ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
     ("camera.wgsl", include_str!("../../shaders/camera.wgsl")),
     ("microfacet.wgsl", include_str!("../../shaders/microfacet.wgsl")),

@@ -1,8 +1,9 @@
 //! glTF 2.0 import (.gltf and .glb) into a flat world-space `Scene`.
 
-use super::{Camera, Material, Scene, Triangle};
+use super::tangents::generate_tangents;
+use super::{AlphaMode, Camera, Material, PunctualKind, PunctualLight, Scene, Texture, TextureRef, Triangle, Wrap};
 use crate::Error;
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use std::path::Path;
 
 /// Refuse scenes beyond this before allocating for them (hostile counts).
@@ -13,13 +14,32 @@ pub const MAX_FILE_BYTES: u64 = 4 << 30;
 pub const MAX_NODE_VISITS: usize = 1 << 20;
 
 /// Extensions veach reads (or can safely ignore) when a file requires them.
-pub const SUPPORTED_EXTENSIONS: &[&str] =
-    &["KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_ior"];
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_materials_emissive_strength",
+    "KHR_materials_specular",
+    "KHR_materials_ior",
+    "KHR_texture_transform",
+    "KHR_materials_transmission",
+    "KHR_materials_volume",
+    "KHR_lights_punctual",
+];
 
-/// Extensions veach knows and ignores for now (textures, transmission, lights come later);
-/// files that merely use them render, with one warning each.
-const KNOWN_UNIMPLEMENTED: &[&str] =
-    &["KHR_texture_transform", "KHR_materials_transmission", "KHR_materials_volume", "KHR_lights_punctual"];
+/// Extensions veach knows and ignores for now; files that merely use them render, with one
+/// warning each.
+const KNOWN_UNIMPLEMENTED: &[&str] = &[
+    "KHR_materials_clearcoat",
+    "KHR_materials_sheen",
+    "KHR_materials_iridescence",
+    "KHR_materials_anisotropy",
+    "KHR_materials_dispersion",
+    "KHR_materials_unlit",
+    "KHR_materials_variants",
+    "KHR_texture_basisu",
+    "EXT_texture_webp",
+];
+
+/// Largest image side decoded; bigger images are refused with a warning.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
 
 pub fn load(path: &Path) -> Result<Scene, Error> {
     let fail = |msg: String| Error::Input(format!("{}: {msg}", path.display()));
@@ -50,7 +70,8 @@ pub fn load_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
     let blob = gltf.blob.clone();
     let buffers = contained(|| gltf::import_buffers(&gltf.document, base.or(Some(Path::new("."))), blob))?
         .map_err(|e| describe(&e))?;
-    let mut scene = from_document(&gltf.document, &buffers)?;
+    let base = base.or(Some(Path::new(".")));
+    let mut scene = contained(|| from_document(&gltf.document, &buffers, base, &mut warnings))??;
     scene.warnings = warnings;
     Ok(scene)
 }
@@ -175,11 +196,32 @@ fn check_extensions(raw: &serde_json::Value, warnings: &mut Vec<String>) -> Resu
     Ok(())
 }
 
-fn from_document(doc: &gltf::Document, buffers: &[gltf::buffer::Data]) -> Result<Scene, String> {
+fn from_document(
+    doc: &gltf::Document,
+    buffers: &[gltf::buffer::Data],
+    base: Option<&Path>,
+    warnings: &mut Vec<String>,
+) -> Result<Scene, String> {
     let mut scene = Scene::default();
 
+    // Images, decoded once each (in parallel: PNG/JPEG decoding dominates loading big models).
+    let images: Vec<gltf::Image> = doc.images().collect();
+    let decoded: Vec<Result<Texture, String>> = {
+        use rayon::prelude::*;
+        images.par_iter().map(|image| decode_image(image, base, buffers)).collect()
+    };
+    let mut image_slot = vec![None; images.len()];
+    for (i, result) in decoded.into_iter().enumerate() {
+        match result {
+            Ok(texture) => {
+                image_slot[i] = Some(scene.textures.len() as u32);
+                scene.textures.push(texture);
+            }
+            Err(e) => warnings.push(format!("image {i}: {e}; rendering without it")),
+        }
+    }
     for m in doc.materials() {
-        scene.materials.push(convert_material(&m));
+        scene.materials.push(convert_material(&m, &image_slot, warnings));
     }
     // Primitives without a material use glTF's default one, appended last.
     let default_material = scene.materials.len() as u32;
@@ -221,6 +263,9 @@ fn from_document(doc: &gltf::Document, buffers: &[gltf::buffer::Data]) -> Result
         if let Some(mesh) = node.mesh() {
             load_mesh(&mesh, world, buffers, default_material, &mut scene)?;
         }
+        if let Some(light) = node.light() {
+            scene.punctual_lights.extend(convert_light(&light, world));
+        }
         for child in node.children() {
             stack.push((child, world, depth + 1));
         }
@@ -252,9 +297,9 @@ fn describe(e: &gltf::Error) -> String {
     }
 }
 
-fn convert_material(m: &gltf::Material) -> Material {
+fn convert_material(m: &gltf::Material, image_slot: &[Option<u32>], warnings: &mut Vec<String>) -> Material {
     let pbr = m.pbr_metallic_roughness();
-    let [r, g, b, _a] = pbr.base_color_factor();
+    let [r, g, b, a] = pbr.base_color_factor();
     let strength = m.emissive_strength().unwrap_or(1.0);
     let (specular_factor, specular_color) = match m.specular() {
         Some(s) => (s.specular_factor(), Vec3::from(s.specular_color_factor())),
@@ -262,6 +307,58 @@ fn convert_material(m: &gltf::Material) -> Material {
     };
     let sane = |v: f32, lo: f32, hi: f32, default: f32| if v.is_finite() { v.clamp(lo, hi) } else { default };
     let sane3 = |v: Vec3| if v.is_finite() { v.max(Vec3::ZERO) } else { Vec3::ZERO };
+    let name = m.name().map_or_else(|| format!("material {}", m.index().unwrap_or(usize::MAX)), str::to_string);
+    type Transform = ([f32; 2], f32, [f32; 2]);
+    let mut texture = |info: Option<(gltf::texture::Texture, u32, Option<Transform>)>| {
+        let (tex, tex_coord, transform) = info?;
+        let slot = image_slot.get(tex.source().index()).copied().flatten()?;
+        if tex_coord != 0 {
+            warnings.push(format!("{name}: a texture reads TEXCOORD_{tex_coord}; veach reads TEXCOORD_0 only"));
+        }
+        let wrap = |w: gltf::texture::WrappingMode| match w {
+            gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+            gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        };
+        let sampler = tex.sampler();
+        Some(TextureRef {
+            texture: slot,
+            transform: transform.map_or(TextureRef::IDENTITY, |(o, r, s)| uv_transform(o, r, s)),
+            wrap: [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
+        })
+    };
+    fn info<'a>(i: Option<gltf::texture::Info<'a>>) -> Option<(gltf::texture::Texture<'a>, u32, Option<Transform>)> {
+        i.map(|i| {
+            let tt = i.texture_transform();
+            let tex_coord = tt.as_ref().and_then(|t| t.tex_coord()).unwrap_or(i.tex_coord());
+            (i.texture(), tex_coord, tt.map(|t| (t.offset(), t.rotation(), t.scale())))
+        })
+    }
+    let base_color_texture = texture(info(pbr.base_color_texture()));
+    let metallic_roughness_texture = texture(info(pbr.metallic_roughness_texture()));
+    let emissive_texture = texture(info(m.emissive_texture()));
+    let normal = m.normal_texture();
+    let normal_scale = normal.as_ref().map_or(1.0, |n| n.scale());
+    // NormalTexture has no accessor for KHR_texture_transform in gltf 1.4; read its JSON.
+    let normal_texture = texture(normal.map(|n| {
+        let tt = n
+            .extension_value("KHR_texture_transform")
+            .and_then(|v| serde_json::from_value::<gltf::json::extensions::texture::TextureTransform>(v.clone()).ok());
+        let tex_coord = tt.as_ref().and_then(|t| t.tex_coord).unwrap_or(n.tex_coord());
+        (n.texture(), tex_coord, tt.map(|t| (t.offset.0, t.rotation.0, t.scale.0)))
+    }));
+    let alpha_mode = match m.alpha_mode() {
+        gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+        gltf::material::AlphaMode::Mask => AlphaMode::Mask(sane(m.alpha_cutoff().unwrap_or(0.5), 0.0, 1.0, 0.5)),
+        gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+    };
+    let (attenuation_color, attenuation_distance) = match m.volume() {
+        Some(v) => (sane3(Vec3::from(v.attenuation_color())).min(Vec3::ONE), v.attenuation_distance()),
+        None => (Vec3::ONE, f32::INFINITY),
+    };
+    if m.transmission().and_then(|t| t.transmission_texture()).is_some() {
+        warnings.push(format!("{name}: transmissionTexture is not supported; using transmissionFactor"));
+    }
     Material {
         base_color: sane3(Vec3::new(r, g, b)),
         metallic: sane(pbr.metallic_factor(), 0.0, 1.0, 1.0),
@@ -270,7 +367,100 @@ fn convert_material(m: &gltf::Material) -> Material {
         specular_factor: sane(specular_factor, 0.0, 1.0, 1.0),
         specular_color: sane3(specular_color),
         ior: sane(m.ior().unwrap_or(1.5), 1.0, 10.0, 1.5),
+        alpha: sane(a, 0.0, 1.0, 1.0),
+        alpha_mode,
+        double_sided: m.double_sided(),
+        transmission: sane(m.transmission().map_or(0.0, |t| t.transmission_factor()), 0.0, 1.0, 0.0),
+        attenuation_color,
+        attenuation_distance: if attenuation_distance.is_finite() && attenuation_distance > 0.0 {
+            attenuation_distance
+        } else {
+            f32::INFINITY
+        },
+        base_color_texture,
+        metallic_roughness_texture,
+        emissive_texture,
+        normal_texture,
+        normal_scale: sane(normal_scale, -100.0, 100.0, 1.0),
     }
+}
+
+/// KHR_texture_transform's translation × rotation × scale, as two rows of an affine map.
+pub fn uv_transform(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> [[f32; 3]; 2] {
+    let (s, c) = rotation.sin_cos();
+    // The extension's GLSL: column-major mat3(c, s, 0, −s, c, 0, 0, 0, 1) after the scale.
+    let m = [[c * scale[0], -s * scale[1], offset[0]], [s * scale[0], c * scale[1], offset[1]]];
+    if m.iter().flatten().all(|v| v.is_finite()) { m } else { TextureRef::IDENTITY }
+}
+
+/// One glTF image as 8-bit RGBA.
+fn decode_image(image: &gltf::Image, base: Option<&Path>, buffers: &[gltf::buffer::Data]) -> Result<Texture, String> {
+    use gltf::image::{Format, Source};
+    // Bounds of an embedded image, checked before the decoder slices the buffer.
+    if let Source::View { view, .. } = image.source() {
+        let len = buffers.get(view.buffer().index()).map_or(0, |b| b.0.len());
+        if view.offset().checked_add(view.length()).is_none_or(|end| end > len) {
+            return Err("its buffer view runs past the buffer".into());
+        }
+    }
+    let data = contained(|| gltf::image::Data::from_source(image.source(), base, buffers))?
+        .map_err(|e| format!("cannot decode: {e}"))?;
+    let (w, h) = (data.width, data.height);
+    if w == 0 || h == 0 || w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE {
+        return Err(format!("{w}×{h} pixels is outside 1..{MAX_IMAGE_SIDE}"));
+    }
+    let px = &data.pixels;
+    let u16_at = |i: usize| (u16::from_ne_bytes([px[2 * i], px[2 * i + 1]]) >> 8) as u8;
+    let f32_at = |i: usize| {
+        let v = f32::from_ne_bytes([px[4 * i], px[4 * i + 1], px[4 * i + 2], px[4 * i + 3]]);
+        (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+    };
+    let n = (w * h) as usize;
+    let (channels, get): (usize, &dyn Fn(usize) -> u8) = match data.format {
+        Format::R8 => (1, &|i| px[i]),
+        Format::R8G8 => (2, &|i| px[i]),
+        Format::R8G8B8 => (3, &|i| px[i]),
+        Format::R8G8B8A8 => (4, &|i| px[i]),
+        Format::R16 => (1, &u16_at),
+        Format::R16G16 => (2, &u16_at),
+        Format::R16G16B16 => (3, &u16_at),
+        Format::R16G16B16A16 => (4, &u16_at),
+        Format::R32G32B32FLOAT => (3, &f32_at),
+        Format::R32G32B32A32FLOAT => (4, &f32_at),
+    };
+    let mut rgba = Vec::with_capacity(4 * n);
+    for p in 0..n {
+        let c = |k: usize| get(p * channels + k);
+        let texel = match channels {
+            1 => [c(0), c(0), c(0), 255],
+            2 => [c(0), c(0), c(0), c(1)],
+            3 => [c(0), c(1), c(2), 255],
+            _ => [c(0), c(1), c(2), c(3)],
+        };
+        rgba.extend_from_slice(&texel);
+    }
+    let name = image.name().map(str::to_string).unwrap_or_else(|| format!("image {}", image.index()));
+    Ok(Texture { name, width: w, height: h, rgba })
+}
+
+/// A KHR_lights_punctual light placed by its node's world transform.
+fn convert_light(light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Option<PunctualLight> {
+    use gltf::khr_lights_punctual::Kind;
+    let intensity = Vec3::from(light.color()).max(Vec3::ZERO) * light.intensity().max(0.0);
+    let position = world.transform_point3(Vec3::ZERO);
+    let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+    let kind = match light.kind() {
+        Kind::Point => PunctualKind::Point,
+        Kind::Directional => PunctualKind::Directional,
+        Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+            let outer = outer_cone_angle.clamp(0.0, std::f32::consts::FRAC_PI_2);
+            let inner = inner_cone_angle.clamp(0.0, outer);
+            PunctualKind::Spot { cos_inner: inner.cos(), cos_outer: outer.cos() }
+        }
+    };
+    let range = light.range().filter(|r| r.is_finite() && *r > 0.0).unwrap_or(f32::INFINITY);
+    let ok = intensity.is_finite() && position.is_finite() && direction != Vec3::ZERO && direction.is_finite();
+    (ok && intensity.max_element() > 0.0).then_some(PunctualLight { kind, position, direction, intensity, range })
 }
 
 /// `extras.environment = {"type": "constant", "radiance": [r, g, b]}` on the scene, as the
@@ -305,10 +495,13 @@ fn load_mesh(
         }
         let name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
         // Check every accessor we read against its buffer before the reader touches it.
+        use gltf::accessor::Dimensions;
         let attrs = [
-            ("POSITION", prim.get(&gltf::Semantic::Positions), gltf::accessor::Dimensions::Vec3),
-            ("NORMAL", prim.get(&gltf::Semantic::Normals), gltf::accessor::Dimensions::Vec3),
-            ("indices", prim.indices(), gltf::accessor::Dimensions::Scalar),
+            ("POSITION", prim.get(&gltf::Semantic::Positions), Dimensions::Vec3),
+            ("NORMAL", prim.get(&gltf::Semantic::Normals), Dimensions::Vec3),
+            ("TEXCOORD_0", prim.get(&gltf::Semantic::TexCoords(0)), Dimensions::Vec2),
+            ("TANGENT", prim.get(&gltf::Semantic::Tangents), Dimensions::Vec4),
+            ("indices", prim.indices(), Dimensions::Scalar),
         ];
         for (what, accessor, dims) in attrs {
             if let Some(a) = accessor {
@@ -320,38 +513,78 @@ fn load_mesh(
         let Some(positions) = reader.read_positions() else {
             continue;
         };
-        let positions: Vec<Vec3> = positions.map(Vec3::from).collect();
-        let normals: Option<Vec<Vec3>> = reader.read_normals().map(|n| n.map(Vec3::from).collect());
+        let positions: Vec<Vec3> = positions.map(|p| world.transform_point3(Vec3::from(p))).collect();
+        let nv = positions.len();
+        let normals: Option<Vec<Vec3>> = reader
+            .read_normals()
+            .map(|n| n.map(|n| (normal_matrix * Vec3::from(n)).normalize_or_zero()).collect())
+            .filter(|n: &Vec<Vec3>| n.len() == nv);
+        let uvs: Option<Vec<Vec2>> = reader
+            .read_tex_coords(0)
+            .map(|t| t.into_f32().map(Vec2::from).collect())
+            .filter(|t: &Vec<Vec2>| t.len() == nv);
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
-            None => (0..positions.len() as u32).collect(),
+            None => (0..nv as u32).collect(),
         };
-        let tris = triangulate(&indices, mode);
+        let mut tris = triangulate(&indices, mode);
         if scene.triangles.len() + tris.len() > super::gltf::MAX_TRIANGLES {
             return Err(format!("more than {MAX_TRIANGLES} triangles"));
         }
+        if let Some(bad) = tris.iter().flatten().find(|&&i| i as usize >= nv) {
+            return Err(format!("{name}: index {bad} is out of range ({nv} vertices)"));
+        }
+        if mirrored {
+            for t in &mut tris {
+                t.swap(1, 2);
+            }
+        }
         let material = prim.material().index().map_or(default_material, |i| i as u32);
-        for [a, b, c] in tris {
-            let mut idx = [a, b, c];
-            if mirrored {
-                idx.swap(1, 2);
+        let wants_tangents = scene.materials.get(material as usize).is_some_and(|m| m.normal_texture.is_some());
+        // Tangents: the file's (a direction: transformed by the upper 3×3; a mirroring
+        // transform flips the bitangent's handedness), else generated from UVs.
+        let tangents: Option<Vec<Vec4>> = match (&uvs, wants_tangents) {
+            (Some(uvs), true) => {
+                let given: Option<Vec<Vec4>> = reader
+                    .read_tangents()
+                    .map(|t| {
+                        t.map(|t| {
+                            let v = (Mat3::from_mat4(world) * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
+                            let w = if (t[3] < 0.0) != mirrored { -1.0 } else { 1.0 };
+                            v.extend(w)
+                        })
+                        .collect()
+                    })
+                    .filter(|t: &Vec<Vec4>| t.len() == nv && t.iter().all(|v| v.is_finite()));
+                Some(given.unwrap_or_else(|| {
+                    let vertex_normals = normals.clone().unwrap_or_else(|| face_normals_per_vertex(&positions, &tris));
+                    generate_tangents(&positions, &vertex_normals, uvs, &tris)
+                }))
             }
-            if let Some(bad) = idx.iter().find(|&&i| i as usize >= positions.len()) {
-                return Err(format!("{name}: index {bad} is out of range ({} vertices)", positions.len()));
-            }
-            let p = idx.map(|i| world.transform_point3(positions[i as usize]));
+            _ => None,
+        };
+        for idx in tris {
+            let p = idx.map(|i| positions[i as usize]);
             if !p.iter().all(|v| v.is_finite()) {
                 return Err(format!("{name}: non-finite vertex position"));
             }
             let ng = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
             let n = match &normals {
-                Some(ns) if ns.len() == positions.len() => idx.map(|i| {
-                    let n = (normal_matrix * ns[i as usize]).normalize_or_zero();
+                Some(ns) => idx.map(|i| {
+                    let n = ns[i as usize];
                     if n == Vec3::ZERO || !n.is_finite() { ng } else { n }
                 }),
-                _ => [ng; 3],
+                None => [ng; 3],
             };
-            scene.triangles.push(Triangle { positions: p, normals: n, material });
+            let uv = match &uvs {
+                Some(t) => idx.map(|i| {
+                    let v = t[i as usize];
+                    if v.is_finite() { v } else { Vec2::ZERO }
+                }),
+                None => [Vec2::ZERO; 3],
+            };
+            let tangents = tangents.as_ref().map_or([Vec4::ZERO; 3], |t| idx.map(|i| t[i as usize]));
+            scene.triangles.push(Triangle { positions: p, normals: n, uvs: uv, tangents, material });
         }
     }
     Ok(())
@@ -375,6 +608,8 @@ fn check_accessor(
     }
     let ok_type = match a.dimensions() {
         Dimensions::Scalar => matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32),
+        // Texture coordinates may be normalised integers.
+        Dimensions::Vec2 => a.data_type() == DataType::F32 || (a.normalized() && a.data_type() != DataType::U32),
         _ => a.data_type() == DataType::F32,
     };
     if !ok_type {
@@ -402,6 +637,19 @@ fn check_accessor(
         return Err(format!("{} elements need {need} bytes, its view has {}", a.count(), view.length()));
     }
     Ok(())
+}
+
+/// Area-weighted face normals averaged per vertex (for tangent generation without NORMAL).
+fn face_normals_per_vertex(positions: &[Vec3], tris: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut n = vec![Vec3::ZERO; positions.len()];
+    for t in tris {
+        let p = t.map(|i| positions[i as usize]);
+        let c = (p[1] - p[0]).cross(p[2] - p[0]);
+        for i in t {
+            n[*i as usize] += c;
+        }
+    }
+    n.into_iter().map(|v| v.normalize_or(Vec3::Z)).collect()
 }
 
 fn triangulate(indices: &[u32], mode: gltf::mesh::Mode) -> Vec<[u32; 3]> {

@@ -6,17 +6,23 @@
 pub mod camera;
 pub mod environment;
 pub mod gltf;
+pub mod tangents;
 
 pub use camera::Camera;
 pub use environment::EnvironmentMap;
-use glam::Vec3;
+use glam::{Vec2, Vec3, Vec4};
 
 /// One world-space triangle. Counter-clockwise winding is the front face.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct Triangle {
     pub positions: [Vec3; 3],
     /// Per-vertex shading normals (equal to the geometric normal for flat meshes).
     pub normals: [Vec3; 3],
+    /// TEXCOORD_0 per vertex (zero when the mesh has none).
+    pub uvs: [Vec2; 3],
+    /// World-space tangent per vertex, w = handedness (±1) of the bitangent cross(n, t)·w;
+    /// all zero when the triangle has no tangent frame (no UVs or no normal map).
+    pub tangents: [Vec4; 3],
     pub material: u32,
 }
 
@@ -31,6 +37,71 @@ impl Triangle {
     }
 }
 
+/// A sampler's wrap mode along one texture axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Wrap {
+    #[default]
+    Repeat = 0,
+    MirroredRepeat = 1,
+    ClampToEdge = 2,
+}
+
+/// A material's use of a texture: which image, how UVs map onto it, how it wraps.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureRef {
+    /// Index into `Scene::textures`.
+    pub texture: u32,
+    /// Affine UV transform (KHR_texture_transform): uv' = (row0 · (u, v, 1), row1 · (u, v, 1)).
+    pub transform: [[f32; 3]; 2],
+    pub wrap: [Wrap; 2],
+}
+
+impl TextureRef {
+    pub const IDENTITY: [[f32; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+}
+
+/// An image as decoded: 8-bit RGBA, rows top to bottom (glTF's v = 0 is the top row).
+#[derive(Clone, Debug, Default)]
+pub struct Texture {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum AlphaMode {
+    #[default]
+    Opaque,
+    /// Surfaces with alpha below the cutoff are not there.
+    Mask(f32),
+    /// Surfaces are there with probability alpha (stochastic transparency).
+    Blend,
+}
+
+/// KHR_lights_punctual: a light with no area, reached by next-event estimation only.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PunctualKind {
+    /// Intensity in candela (W/sr in veach's radiometric units).
+    Point,
+    /// Point light within a cone (cosines of the inner and outer half-angles).
+    Spot { cos_inner: f32, cos_outer: f32 },
+    /// Illuminance in lux (W/m²) on a surface facing the light.
+    Directional,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PunctualLight {
+    pub kind: PunctualKind,
+    pub position: Vec3,
+    /// Unit direction the light travels (the node's −Z).
+    pub direction: Vec3,
+    /// color × intensity.
+    pub intensity: Vec3,
+    /// Distance where the light fades to zero (glTF's recommended window); infinite when absent.
+    pub range: f32,
+}
+
 /// glTF metallic-roughness material, as path tracers read it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
@@ -43,6 +114,22 @@ pub struct Material {
     pub specular_factor: f32,
     pub specular_color: Vec3,
     pub ior: f32,
+    /// baseColorFactor's alpha.
+    pub alpha: f32,
+    pub alpha_mode: AlphaMode,
+    pub double_sided: bool,
+    /// KHR_materials_transmission.transmissionFactor: the share of the non-metal part that
+    /// refracts instead of scattering diffusely.
+    pub transmission: f32,
+    /// KHR_materials_volume: the color white light reaches after `attenuation_distance` inside.
+    pub attenuation_color: Vec3,
+    pub attenuation_distance: f32,
+    pub base_color_texture: Option<TextureRef>,
+    /// Green = roughness, blue = metallic.
+    pub metallic_roughness_texture: Option<TextureRef>,
+    pub emissive_texture: Option<TextureRef>,
+    pub normal_texture: Option<TextureRef>,
+    pub normal_scale: f32,
 }
 
 impl Default for Material {
@@ -56,6 +143,17 @@ impl Default for Material {
             specular_factor: 1.0,
             specular_color: Vec3::ONE,
             ior: 1.5,
+            alpha: 1.0,
+            alpha_mode: AlphaMode::Opaque,
+            double_sided: false,
+            transmission: 0.0,
+            attenuation_color: Vec3::ONE,
+            attenuation_distance: f32::INFINITY,
+            base_color_texture: None,
+            metallic_roughness_texture: None,
+            emissive_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
         }
     }
 }
@@ -101,6 +199,8 @@ pub struct Scene {
     /// scale of `environment_map` when there is one.
     pub environment: Vec3,
     pub environment_map: Option<EnvironmentMap>,
+    pub textures: Vec<Texture>,
+    pub punctual_lights: Vec<PunctualLight>,
     /// Things the loader ignored, one line each (unknown optional extensions, ...).
     pub warnings: Vec<String>,
 }

@@ -1,0 +1,98 @@
+// The material at a surface point: glTF factors times textures (base color and alpha,
+// metallic-roughness with G = roughness and B = metallic, emissive), alpha for MASK and
+// BLEND, and the shading normal with the normal map applied in the vertex tangent frame.
+// Twin: src/cpu/material.rs.
+#include "bindings.wgsl"
+#include "rng.wgsl"
+#include "frame.wgsl"
+#include "texture.wgsl"
+
+// TEXCOORD_0 at barycentrics (u, v) of vertices 1 and 2.
+fn triangle_uv(index: u32, u: f32, v: f32) -> vec2<f32> {
+    let a = attributes[index];
+    return (1.0 - u - v) * a.uv0 + u * a.uv1 + v * a.uv2;
+}
+
+fn material_at(m: Material, uv: vec2<f32>) -> Material {
+    var r = m;
+    if (m.base_color_texture.layer != NO_TEXTURE) {
+        let c = sample_texture(m.base_color_texture, uv);
+        r.base_color = m.base_color * c.xyz;
+        r.alpha = m.alpha * c.w;
+    }
+    if (m.metallic_roughness_texture.layer != NO_TEXTURE) {
+        let c = sample_texture(m.metallic_roughness_texture, uv);
+        r.roughness = m.roughness * c.y;
+        r.metallic = m.metallic * c.z;
+    }
+    if (m.emissive_texture.layer != NO_TEXTURE) {
+        r.emission = m.emission * sample_texture(m.emissive_texture, uv).xyz;
+    }
+    return r;
+}
+
+// Does a ray stop at this triangle? MASK: alpha at or above the cutoff. BLEND: with
+// probability alpha (stochastic transparency), decided by a hash of the ray and the triangle
+// so that the decision is the same for the closest-hit and the shadow query of one ray.
+fn alpha_passes(index: u32, u: f32, v: f32, ray: Ray) -> bool {
+    let tri = triangles[index];
+    let m = materials[tri.material];
+    var alpha = m.alpha;
+    if (m.base_color_texture.layer != NO_TEXTURE) {
+        alpha *= sample_texture(m.base_color_texture, triangle_uv(index, u, v)).w;
+    }
+    if ((m.flags & MAT_ALPHA_MASK) != 0u) {
+        return alpha >= m.alpha_cutoff;
+    }
+    let o = bitcast<vec3<u32>>(ray.origin);
+    let d = bitcast<vec3<u32>>(ray.dir);
+    let h = pcg_hash(index ^ pcg_hash(o.x ^ pcg_hash(o.y ^ pcg_hash(o.z ^ pcg_hash(d.x ^ pcg_hash(d.y ^ d.z))))));
+    return f32(h >> 8u) * (1.0 / 16777216.0) < alpha;
+}
+
+fn oct_decode(bits: u32) -> vec3<f32> {
+    let e = unpack2x16snorm(bits);
+    let z = 1.0 - abs(e.x) - abs(e.y);
+    let t = max(-z, 0.0);
+    let x = e.x + select(t, -t, e.x >= 0.0);
+    let y = e.y + select(t, -t, e.y >= 0.0);
+    return normalize(vec3<f32>(x, y, z));
+}
+
+// The front-facing shading normal at (u, v): interpolated vertex normals (else ng), then the
+// normal map: n' = T·x + B·y + N·z with T Gram-Schmidt'd against N and B = cross(N, T)·w.
+fn shading_normal(tri: Triangle, index: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec2<f32>) -> vec3<f32> {
+    var n = ng;
+    let a = attributes[index];
+    if ((tri.flags & TRI_HAS_NORMALS) != 0u) {
+        let s = (1.0 - u - v) * oct_decode(a.n.x) + u * oct_decode(a.n.y) + v * oct_decode(a.n.z);
+        let len2 = dot(s, s);
+        n = select(ng, s * inverseSqrt(len2), len2 > 0.0);
+    }
+    if ((tri.flags & TRI_HAS_TANGENTS) == 0u || m.normal_texture.layer == NO_TEXTURE) {
+        return n;
+    }
+    let t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12.x) + v * oct_decode(a.t12.y);
+    let t_ortho = t_interp - n * dot(n, t_interp);
+    let len2 = dot(t_ortho, t_ortho);
+    if (len2 <= 1e-12) {
+        return n;
+    }
+    let t = t_ortho * inverseSqrt(len2);
+    // The handedness of the vertex nearest to the point (all three agree within an island).
+    let w = select(1.0, -1.0, ((tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1u) != 0u);
+    let b = cross(n, t) * w;
+    let c = sample_texture(m.normal_texture, uv).xyz * 2.0 - 1.0;
+    let mapped = t * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + n * c.z;
+    let mlen2 = dot(mapped, mapped);
+    return select(n, mapped * inverseSqrt(mlen2), mlen2 > 1e-12);
+}
+
+// Index of the vertex with the largest barycentric weight.
+fn nearest_vertex(u: f32, v: f32) -> u32 {
+    let w0 = 1.0 - u - v;
+    if (w0 >= u && w0 >= v) {
+        return 0u;
+    }
+    return select(2u, 1u, u >= v);
+}

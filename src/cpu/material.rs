@@ -1,0 +1,92 @@
+//! Twin of `shaders/material.wgsl`: textured material, alpha and the normal-mapped shading normal.
+
+use super::bvh::Ray;
+use super::rng::pcg_hash;
+use super::texture::sample_texture;
+use crate::packed::{
+    MAT_ALPHA_MASK, NO_TEXTURE, PackedMaterial, PackedScene, PackedTriangle, TRI_HAS_NORMALS, TRI_HAS_TANGENTS,
+    TRI_TANGENT_SIGN_SHIFT, oct_decode,
+};
+use glam::{Vec2, Vec3};
+
+pub fn triangle_uv(scene: &PackedScene, index: u32, u: f32, v: f32) -> Vec2 {
+    let a = &scene.attributes[index as usize];
+    (1.0 - u - v) * Vec2::from(a.uv[0]) + u * Vec2::from(a.uv[1]) + v * Vec2::from(a.uv[2])
+}
+
+pub fn material_at(scene: &PackedScene, m: &PackedMaterial, uv: Vec2) -> PackedMaterial {
+    let mut r = *m;
+    if m.base_color_texture.layer != NO_TEXTURE {
+        let c = sample_texture(scene, &m.base_color_texture, uv);
+        r.base_color = (Vec3::from(m.base_color) * c.truncate()).into();
+        r.alpha = m.alpha * c.w;
+    }
+    if m.metallic_roughness_texture.layer != NO_TEXTURE {
+        let c = sample_texture(scene, &m.metallic_roughness_texture, uv);
+        r.roughness = m.roughness * c.y;
+        r.metallic = m.metallic * c.z;
+    }
+    if m.emissive_texture.layer != NO_TEXTURE {
+        r.emission = (Vec3::from(m.emission) * sample_texture(scene, &m.emissive_texture, uv).truncate()).into();
+    }
+    r
+}
+
+pub fn alpha_passes(scene: &PackedScene, index: u32, u: f32, v: f32, ray: &Ray) -> bool {
+    let tri = &scene.triangles[index as usize];
+    let m = &scene.materials[tri.material as usize];
+    let mut alpha = m.alpha;
+    if m.base_color_texture.layer != NO_TEXTURE {
+        alpha *= sample_texture(scene, &m.base_color_texture, triangle_uv(scene, index, u, v)).w;
+    }
+    if m.flags & MAT_ALPHA_MASK != 0 {
+        return alpha >= m.alpha_cutoff;
+    }
+    let (o, d) = (ray.origin.to_array().map(f32::to_bits), ray.dir.to_array().map(f32::to_bits));
+    let h = pcg_hash(index ^ pcg_hash(o[0] ^ pcg_hash(o[1] ^ pcg_hash(o[2] ^ pcg_hash(d[0] ^ pcg_hash(d[1] ^ d[2]))))));
+    ((h >> 8) as f32 * (1.0 / 16777216.0)) < alpha
+}
+
+pub fn nearest_vertex(u: f32, v: f32) -> u32 {
+    let w0 = 1.0 - u - v;
+    if w0 >= u && w0 >= v {
+        return 0;
+    }
+    if u >= v { 1 } else { 2 }
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn shading_normal(
+    scene: &PackedScene,
+    tri: &PackedTriangle,
+    index: u32,
+    u: f32,
+    v: f32,
+    ng: Vec3,
+    m: &PackedMaterial,
+    uv: Vec2,
+) -> Vec3 {
+    let mut n = ng;
+    let a = &scene.attributes[index as usize];
+    if tri.flags & TRI_HAS_NORMALS != 0 {
+        let s = (1.0 - u - v) * oct_decode(a.n[0]) + u * oct_decode(a.n[1]) + v * oct_decode(a.n[2]);
+        let len2 = s.dot(s);
+        n = if len2 > 0.0 { s / len2.sqrt() } else { ng };
+    }
+    if tri.flags & TRI_HAS_TANGENTS == 0 || m.normal_texture.layer == NO_TEXTURE {
+        return n;
+    }
+    let t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12[0]) + v * oct_decode(a.t12[1]);
+    let t_ortho = t_interp - n * n.dot(t_interp);
+    let len2 = t_ortho.dot(t_ortho);
+    if len2 <= 1e-12 {
+        return n;
+    }
+    let t = t_ortho / len2.sqrt();
+    let w = if (tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1 != 0 { -1.0 } else { 1.0 };
+    let b = n.cross(t) * w;
+    let c = sample_texture(scene, &m.normal_texture, uv).truncate() * 2.0 - Vec3::ONE;
+    let mapped = t * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + n * c.z;
+    let mlen2 = mapped.dot(mapped);
+    if mlen2 > 1e-12 { mapped / mlen2.sqrt() } else { n }
+}

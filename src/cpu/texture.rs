@@ -1,0 +1,45 @@
+//! Twin of `shaders/texture.wgsl`: bilinear texture reads with glTF wrap modes.
+
+use crate::packed::{PackedScene, PackedTextureRef, TEX_SRGB};
+use glam::{Vec2, Vec3, Vec4};
+
+pub fn wrap_texel(i: i32, n: i32, mode: u32) -> i32 {
+    if mode == 2 {
+        return i.clamp(0, n - 1);
+    }
+    if mode == 1 {
+        let m = i.rem_euclid(2 * n);
+        return if m >= n { 2 * n - 1 - m } else { m };
+    }
+    i.rem_euclid(n)
+}
+
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+fn texel(scene: &PackedScene, t: &PackedTextureRef, x: i32, y: i32, n: i32) -> Vec4 {
+    let (x, y) = (wrap_texel(x, n, t.mode & 3), wrap_texel(y, n, (t.mode >> 2) & 3));
+    let index = (t.layer as usize * n as usize + y as usize) * n as usize + x as usize;
+    let c = scene.texels[index].to_le_bytes().map(|b| b as f32 / 255.0);
+    if t.mode & TEX_SRGB != 0 {
+        Vec4::new(srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3])
+    } else {
+        Vec4::from(c)
+    }
+}
+
+pub fn sample_texture(scene: &PackedScene, t: &PackedTextureRef, uv: Vec2) -> Vec4 {
+    let n = scene.texture_size as i32;
+    let uv1 = uv.extend(1.0);
+    let st = Vec2::new(Vec3::from(t.row0).dot(uv1), Vec3::from(t.row1).dot(uv1));
+    let fix = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(-1e6, 1e6) };
+    let st = Vec2::new(fix(st.x), fix(st.y));
+    let p = st * n as f32 - 0.5;
+    let p0 = p.floor();
+    let f = p - p0;
+    let (x, y) = (p0.x as i32, p0.y as i32);
+    let top = texel(scene, t, x, y, n).lerp(texel(scene, t, x + 1, y, n), f.x);
+    let bottom = texel(scene, t, x, y + 1, n).lerp(texel(scene, t, x + 1, y + 1, n), f.x);
+    top.lerp(bottom, f.y)
+}
