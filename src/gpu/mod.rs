@@ -30,6 +30,7 @@ pub fn adapters() -> Vec<(wgpu::AdapterInfo, wgpu::Limits)> {
 }
 
 /// A device and queue, with wgpu errors captured instead of panicking.
+#[derive(Clone)]
 pub struct GpuContext {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,

@@ -388,8 +388,9 @@ fn convert_material(m: &gltf::Material, image_slot: &[Option<u32>], warnings: &m
 /// KHR_texture_transform's translation × rotation × scale, as two rows of an affine map.
 pub fn uv_transform(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> [[f32; 3]; 2] {
     let (s, c) = rotation.sin_cos();
-    // The extension's GLSL: column-major mat3(c, s, 0, −s, c, 0, 0, 0, 1) after the scale.
-    let m = [[c * scale[0], -s * scale[1], offset[0]], [s * scale[0], c * scale[1], offset[1]]];
+    // u' = c·u + s·v, v' = −s·u + c·v after the scale: the UVs turn counter-clockwise in the
+    // image's frame (v down), as Khronos' TextureTransformTest shows (arrow on "Correct").
+    let m = [[c * scale[0], s * scale[1], offset[0]], [-s * scale[0], c * scale[1], offset[1]]];
     if m.iter().flatten().all(|v| v.is_finite()) { m } else { TextureRef::IDENTITY }
 }
 

@@ -3,8 +3,11 @@
 //! Per triangle, the tangent T and bitangent B solve ΔPos = ΔUV.x·T + ΔUV.y·B for both edges
 //! (the theory's "Tangents and bitangents based on UVs"); each vertex averages the T and B of
 //! its triangles, then T is made orthogonal to the vertex normal (Gram-Schmidt) and the
-//! handedness w = ±1 records whether B agrees with cross(N, T), so mirrored UV islands keep
-//! their bumps the right way round.
+//! handedness w = ±1 records whether the normal map's +Y agrees with cross(N, T), so mirrored
+//! UV islands keep their bumps the right way round.
+//!
+//! glTF's v runs down the image while normal maps store +Y up the image (the OpenGL
+//! convention, as MikkTSpace sees UVs after loaders flip v): the map's +Y is −B, not B.
 
 use glam::{Vec2, Vec3, Vec4};
 
@@ -48,13 +51,14 @@ pub fn generate_tangents(positions: &[Vec3], normals: &[Vec3], uvs: &[Vec2], tri
         .collect()
 }
 
-/// Gram-Schmidt of `t` against `n`, with the handedness of `b` relative to cross(n, t).
+/// Gram-Schmidt of `t` against `n`, with the handedness of the normal map's +Y (= −b, b being
+/// ∂P/∂v) relative to cross(n, t).
 pub fn orthonormal_tangent(n: Vec3, t: Vec3, b: Vec3) -> Vec4 {
     let mut tt = (t - n * n.dot(t)).normalize_or_zero();
     if tt == Vec3::ZERO {
         tt = n.any_orthonormal_vector();
     }
-    let w = if n.cross(tt).dot(b) < 0.0 { -1.0 } else { 1.0 };
+    let w = if n.cross(tt).dot(-b) < 0.0 { -1.0 } else { 1.0 };
     tt.extend(w)
 }
 
@@ -84,12 +88,14 @@ mod tests {
 
     #[test]
     fn mirrored_uvs_flip_the_handedness() {
-        let p = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        // A quad facing +z showing its image upright: u along +x, v (down the image) along −y.
+        let p = [Vec3::ZERO, Vec3::X, -Vec3::Y];
         let n = [Vec3::Z; 3];
         let straight = generate_tangents(&p, &n, &[Vec2::ZERO, Vec2::X, Vec2::Y], &[[0, 1, 2]]);
-        let mirrored = generate_tangents(&p, &n, &[Vec2::ZERO, -Vec2::X, Vec2::Y], &[[0, 1, 2]]);
+        // The map's +Y (up the image) is world +y = cross(N, T): right-handed.
         assert_eq!(straight[0], Vec4::new(1.0, 0.0, 0.0, 1.0));
-        // u runs along −x: the tangent points to −x and B = cross(N, T)·w must still be +y.
+        // Mirrored: u runs along −x. T points to −x, and B = cross(N, T)·w must still be +y.
+        let mirrored = generate_tangents(&p, &n, &[Vec2::ZERO, -Vec2::X, Vec2::Y], &[[0, 1, 2]]);
         assert_eq!(mirrored[0], Vec4::new(-1.0, 0.0, 0.0, -1.0));
         let b = Vec3::Z.cross(mirrored[0].truncate()) * mirrored[0].w;
         assert!((b - Vec3::Y).length() < 1e-6);

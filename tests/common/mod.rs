@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod build;
+
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 use veach::film::Film;

@@ -1,0 +1,349 @@
+//! glTF as users bring it, checked against expectations computed here, independently of
+//! veach's code: textures (orientation, sRGB, wrap, KHR_texture_transform), alpha MASK and
+//! BLEND, normal maps through generated and supplied tangents, punctual lights against the
+//! analytic irradiance, glass in a furnace. Each scene is built in code (tests/common/build.rs)
+//! and rendered on the CPU reference and, when there is one, on the GPU.
+
+mod common;
+
+use common::build::{GltfBuilder, MeshData};
+use common::{agreement, film_stats, gpu};
+use glam::{Quat, Vec3};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use veach::film::Film;
+use veach::{Backend, Renderer, Settings};
+
+const CLAMP: u32 = 33071;
+const REPEAT: u32 = 10497;
+
+fn dir(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("veach-materials-{}-{name}", std::process::id()))
+}
+
+fn srgb_to_linear(c: u8) -> f32 {
+    let c = c as f32 / 255.0;
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// Renders on the CPU and, when available, on the GPU: (backend name, film) pairs.
+fn render_both(path: &Path, settings: &Settings, spp: u32, test: &str) -> Vec<(&'static str, Film)> {
+    let (scene, camera) = veach::load(path, None).unwrap_or_else(|e| panic!("{test}: {e}"));
+    let packed = veach::packed::PackedScene::new(&scene);
+    let mut out = Vec::new();
+    let mut cpu = Renderer::new(packed.clone(), &camera, settings, Backend::Cpu).unwrap();
+    cpu.render_samples(0, spp).unwrap();
+    out.push(("cpu", cpu.film().unwrap()));
+    if let Some(ctx) = gpu(test) {
+        let mut g = Renderer::with_gpu(packed, &camera, settings, Backend::Gpu, Some(ctx)).unwrap();
+        g.render_samples(0, spp).unwrap();
+        out.push(("gpu", g.film().unwrap()));
+    }
+    out
+}
+
+fn settings(width: u32, height: u32, max_depth: u32) -> Settings {
+    Settings { width, height, max_depth, environment: Some(Vec3::ZERO), ..Settings::default() }
+}
+
+/// A camera at z = `d` looking down −z whose view spans y ∈ [−half, half] on the plane z = 0.
+fn camera_for(b: &mut GltfBuilder, d: f32, half: f32, aspect: f32) {
+    b.camera(2.0 * (half / d).atan(), aspect, [0.0, 0.0, d]);
+}
+
+/// 4×4 texels in 2×2 blocks: A top-left, B top-right, C bottom-left, D bottom-right (sRGB).
+const BLOCKS: [[u8; 3]; 4] = [[200, 30, 30], [30, 200, 30], [30, 30, 200], [220, 220, 60]];
+
+fn block_texture() -> image::RgbaImage {
+    image::RgbaImage::from_fn(4, 4, |x, y| {
+        let c = BLOCKS[(y / 2 * 2 + x / 2) as usize];
+        image::Rgba([c[0], c[1], c[2], 255])
+    })
+}
+
+#[test]
+fn emissive_textures_show_upright_in_linear_rgb_with_wrap_and_transform() {
+    let d = dir("textures");
+    let mut b = GltfBuilder::new(&d, "textures");
+    b.use_extension("KHR_texture_transform");
+    let clamp = b.texture(&block_texture(), CLAMP);
+    let repeat = b.texture(&block_texture(), REPEAT);
+    let black = json!({"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0});
+    let plain = b.material(json!({"pbrMetallicRoughness": black, "emissiveFactor": [1, 1, 1],
+        "emissiveTexture": {"index": clamp}}));
+    let shifted = b.material(json!({"pbrMetallicRoughness": black, "emissiveFactor": [1, 1, 1],
+        "emissiveTexture": {"index": repeat, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0.0]}}}}));
+    let left = b.mesh(&MeshData::quad(-2.0, -1.0, 0.0, 1.0, 0.0, MeshData::UPRIGHT), plain);
+    let right = b.mesh(&MeshData::quad(0.0, -1.0, 2.0, 1.0, 0.0, MeshData::UPRIGHT), shifted);
+    b.node(json!({"mesh": left}));
+    b.node(json!({"mesh": right}));
+    camera_for(&mut b, 3.0, 1.0, 2.0);
+    let path = b.write();
+    // Pixel centres at u, v ≈ 0.26 or 0.76 sit inside one block even after bilinear filtering.
+    // Right quad: u + 0.5 with repeat swaps the left and right blocks.
+    let expect = [
+        ((16, 16), 0),
+        ((48, 16), 1),
+        ((16, 48), 2),
+        ((48, 48), 3),
+        ((80, 16), 1),
+        ((112, 16), 0),
+        ((80, 48), 3),
+        ((112, 48), 2),
+    ];
+    for (backend, film) in render_both(&path, &settings(128, 64, 1), 4, "textures") {
+        for ((x, y), block) in expect {
+            let got = film.mean(y * 128 + x);
+            let want = Vec3::from(BLOCKS[block].map(srgb_to_linear));
+            assert!(
+                (got - want).abs().max_element() < 2e-3 + 2e-3 * want.max_element(),
+                "{backend}: pixel ({x}, {y}) is {got}, expected block {block} = {want}"
+            );
+        }
+    }
+}
+
+#[test]
+fn alpha_mask_cuts_and_blend_lets_light_through_in_proportion() {
+    let d = dir("alpha");
+    let mut b = GltfBuilder::new(&d, "alpha");
+    // Left half of the mask texture transparent, right half opaque.
+    let mask = image::RgbaImage::from_fn(4, 4, |x, _| image::Rgba([255, 255, 255, if x < 2 { 0 } else { 255 }]));
+    let mask = b.texture(&mask, CLAMP);
+    let light =
+        b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [1, 1, 1]}));
+    let masked = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1],
+        "baseColorTexture": {"index": mask}}, "alphaMode": "MASK", "alphaCutoff": 0.5}));
+    let blended =
+        b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 0.25]}, "alphaMode": "BLEND"}));
+    let back = b.mesh(&MeshData::quad(-10.0, -10.0, 10.0, 10.0, -1.0, MeshData::UPRIGHT), light);
+    let left = b.mesh(&MeshData::quad(-2.0, -1.0, 0.0, 1.0, 0.0, MeshData::UPRIGHT), masked);
+    let right = b.mesh(&MeshData::quad(0.0, -1.0, 2.0, 1.0, 0.0, MeshData::UPRIGHT), blended);
+    for m in [back, left, right] {
+        b.node(json!({"mesh": m}));
+    }
+    camera_for(&mut b, 3.0, 1.0, 2.0);
+    let path = b.write();
+    let spp = 64;
+    for (backend, film) in render_both(&path, &settings(128, 64, 1), spp, "alpha") {
+        let region = |x0: usize, x1: usize| {
+            let mut sum = 0.0f64;
+            let mut n = 0;
+            for y in 4..60 {
+                for x in x0..x1 {
+                    sum += film.mean(y * 128 + x).y as f64;
+                    n += 1;
+                }
+            }
+            sum / n as f64
+        };
+        // Mask: the transparent half shows the light behind, the opaque half is black.
+        assert!((region(4, 28) - 1.0).abs() < 1e-4, "{backend}: masked-out half {}", region(4, 28));
+        assert!(region(36, 60) < 1e-4, "{backend}: opaque half {}", region(36, 60));
+        // Blend, α = 0.25: a quarter of the rays stop at the black quad. The region holds
+        // 56 × 56 pixels × 64 samples; the binomial standard error of the mean is < 0.001.
+        let seen = region(68, 124);
+        assert!((seen - 0.75).abs() < 0.005, "{backend}: blended region {seen}, expected 0.75");
+    }
+}
+
+/// A hemisphere bump in tangent space, in the image convention glTF uses (+X right, +Y up).
+fn bump_normal_map() -> image::RgbaImage {
+    image::RgbaImage::from_fn(64, 64, |x, y| {
+        let dx = (x as f32 + 0.5) / 64.0 - 0.5;
+        let dy = 0.5 - (y as f32 + 0.5) / 64.0;
+        let r2 = dx * dx + dy * dy;
+        let n = if r2 < 0.16 { Vec3::new(dx, dy, (0.16 - r2).sqrt()).normalize() } else { Vec3::Z };
+        let e = |v: f32| ((v * 0.5 + 0.5) * 255.0).round() as u8;
+        image::Rgba([e(n.x), e(n.y), e(n.z), 255])
+    })
+}
+
+#[test]
+fn normal_maps_light_bumps_from_the_light_side_for_every_uv_layout() {
+    let d = dir("normals");
+    let mut b = GltfBuilder::new(&d, "normals");
+    let map = b.texture(&bump_normal_map(), REPEAT);
+    // Lambertian (no specular layer), so the view direction, different per tile, cannot matter.
+    b.use_extension("KHR_materials_specular");
+    let material = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1],
+        "metallicFactor": 0, "roughnessFactor": 1}, "normalTexture": {"index": map},
+        "extensions": {"KHR_materials_specular": {"specularFactor": 0}}}));
+    // Corner UVs (bottom-left, bottom-right, top-right, top-left): upright, mirrored in u,
+    // rotated 90°, rotated 180°; then mirrored again with supplied tangents (w = −1).
+    let layouts: [[[f32; 2]; 4]; 5] = [
+        MeshData::UPRIGHT,
+        [[1.0, 1.0], [0.0, 1.0], [0.0, 0.0], [1.0, 0.0]],
+        [[1.0, 1.0], [1.0, 0.0], [0.0, 0.0], [0.0, 1.0]],
+        [[1.0, 0.0], [0.0, 0.0], [0.0, 1.0], [1.0, 1.0]],
+        [[1.0, 1.0], [0.0, 1.0], [0.0, 0.0], [1.0, 0.0]],
+    ];
+    for (k, uvs) in layouts.iter().enumerate() {
+        let x0 = -2.5 + k as f32;
+        let mut quad = MeshData::quad(x0, -0.5, x0 + 1.0, 0.5, 0.0, *uvs);
+        if k == 4 {
+            // u runs along −x: T = −x, and the map's +Y is +y = cross(N, T)·w, so w = −1.
+            quad.tangents = vec![[-1.0, 0.0, 0.0, -1.0]; 4];
+        }
+        let mesh = b.mesh(&quad, material);
+        b.node(json!({"mesh": mesh}));
+    }
+    // A directional light from the upper left, travelling along (1, −1, −1).
+    let travel = Vec3::new(1.0, -1.0, -1.0).normalize();
+    let q = Quat::from_rotation_arc(Vec3::NEG_Z, travel);
+    b.light(json!({"type": "directional", "intensity": 3.0}), json!({"rotation": q.to_array()}));
+    camera_for(&mut b, 4.0, 0.5, 5.0);
+    let path = b.write();
+    for (backend, film) in render_both(&path, &settings(320, 64, 2), 8, "normals") {
+        // Mean brightness of the bump's upper-left and lower-right quadrants on each tile.
+        let quadrants = |k: u32| {
+            let (mut ul, mut lr, mut n) = (0.0f32, 0.0f32, 0);
+            for y in 0..64 {
+                for x in 0..64 {
+                    let dx = (x as f32 + 0.5) / 64.0 - 0.5;
+                    let dy = 0.5 - (y as f32 + 0.5) / 64.0;
+                    let r2 = dx * dx + dy * dy;
+                    if !(0.01..0.12).contains(&r2) || dx.abs() < 0.05 || dy.abs() < 0.05 {
+                        continue;
+                    }
+                    let v = film.mean((y * 320 + 64 * k + x) as usize).y;
+                    if dx < 0.0 && dy > 0.0 {
+                        ul += v;
+                        n += 1;
+                    } else if dx > 0.0 && dy < 0.0 {
+                        lr += v;
+                    }
+                }
+            }
+            (ul / n as f32, lr / n as f32)
+        };
+        let (ul0, lr0) = quadrants(0);
+        for k in 0..5 {
+            let (ul, lr) = quadrants(k);
+            assert!(ul > 2.0 * lr, "{backend} tile {k}: the lit side of the bump is dark ({ul} vs {lr})");
+            assert!(
+                (ul - ul0).abs() < 0.05 * ul0 && (lr - lr0).abs() < 0.05 * ul0,
+                "{backend} tile {k}: shades differently from the upright tile ({ul}, {lr} vs {ul0}, {lr0})"
+            );
+        }
+    }
+}
+
+/// A white Lambertian plane z = 0 spanning [−2, 2]², seen from above, lit by one light.
+fn lit_plane(name: &str, light: serde_json::Value, node: serde_json::Value) -> PathBuf {
+    let mut b = GltfBuilder::new(&dir(name), name);
+    b.use_extension("KHR_materials_specular");
+    let white = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1],
+        "metallicFactor": 0, "roughnessFactor": 1}, "extensions": {"KHR_materials_specular": {"specularFactor": 0}}}));
+    let plane = b.mesh(&MeshData::quad(-2.0, -2.0, 2.0, 2.0, 0.0, MeshData::UPRIGHT), white);
+    b.node(json!({"mesh": plane}));
+    b.light(light, node);
+    camera_for(&mut b, 3.0, 2.0, 1.0);
+    b.write()
+}
+
+/// Checks every pixel of a 64×64 render of `lit_plane` against L = E(p) / π averaged over
+/// the pixel (the only randomness left at depth 2 is where in the pixel a sample lands).
+fn check_irradiance(name: &str, path: &Path, irradiance: impl Fn(Vec3) -> f32) {
+    for (backend, film) in render_both(path, &settings(64, 64, 2), 256, name) {
+        let mut worst = 0.0f32;
+        for y in 0..64u32 {
+            for x in 0..64u32 {
+                let mut want = 0.0;
+                for k in 0..256 {
+                    let (sx, sy) = ((k % 16) as f32 + 0.5, (k / 16) as f32 + 0.5);
+                    let p = Vec3::new(
+                        -2.0 + 4.0 * (x as f32 + sx / 16.0) / 64.0,
+                        2.0 - 4.0 * (y as f32 + sy / 16.0) / 64.0,
+                        0.0,
+                    );
+                    want += irradiance(p) / std::f32::consts::PI / 256.0;
+                }
+                let i = (y * 64 + x) as usize;
+                let got = film.mean(i).x;
+                // Where the light varies within a pixel, where the sample lands matters: allow
+                // 4.5 standard errors of the pixel mean on top of 1 %.
+                let sigma = film.variance_of_mean(i).x.sqrt();
+                let err = (got - want).abs() / (0.01 * want + 4.5 * sigma + 1e-6);
+                worst = worst.max((got - want).abs() / want.max(1e-3));
+                assert!(err < 1.0, "{name} {backend}: pixel ({x}, {y}) {got} ± {sigma} vs analytic {want}");
+            }
+        }
+        eprintln!("{name} {backend}: worst relative error {worst:.4} (lit pixels)");
+    }
+}
+
+#[test]
+fn punctual_lights_match_the_analytic_irradiance() {
+    let pos = Vec3::new(0.3, 0.2, 1.0);
+    let point = |p: Vec3| {
+        let d = pos - p;
+        5.0 * (d.z / d.length()) / d.length_squared()
+    };
+    let path = lit_plane("point", json!({"type": "point", "intensity": 5.0}), json!({"translation": pos.to_array()}));
+    check_irradiance("point light", &path, point);
+
+    // A spot pointing straight down: full intensity inside 0.3 rad, none outside 0.6 rad,
+    // glTF's smooth falloff between.
+    let (inner, outer) = (0.3f32, 0.6f32);
+    let down = Quat::from_rotation_arc(Vec3::NEG_Z, Vec3::NEG_Z); // the spot's node looks down −z
+    let path = lit_plane(
+        "spot",
+        json!({"type": "spot", "intensity": 5.0, "spot": {"innerConeAngle": inner, "outerConeAngle": outer}}),
+        json!({"translation": pos.to_array(), "rotation": down.to_array()}),
+    );
+    check_irradiance("spot light", &path, |p| {
+        let d = (p - pos).normalize();
+        let t = ((d.dot(Vec3::NEG_Z) - outer.cos()) / (inner.cos() - outer.cos())).clamp(0.0, 1.0);
+        point(p) * t * t
+    });
+
+    // Directional, lux: E = I cos θ everywhere.
+    let travel = Vec3::new(0.5, 0.0, -1.0).normalize();
+    let q = Quat::from_rotation_arc(Vec3::NEG_Z, travel);
+    let path = lit_plane("sun", json!({"type": "directional", "intensity": 2.0}), json!({"rotation": q.to_array()}));
+    check_irradiance("directional light", &path, |_| 2.0 * travel.z.abs());
+}
+
+/// The white-furnace sphere (assets/furnace-a100.gltf) turned into glass of a roughness.
+fn glass_furnace(roughness: f32) -> PathBuf {
+    let src = std::fs::read(common::asset("furnace-a100.gltf")).unwrap();
+    let mut doc: serde_json::Value = serde_json::from_slice(&src).unwrap();
+    doc["materials"][0] = json!({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0,
+        "roughnessFactor": roughness}, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+        "KHR_materials_ior": {"ior": 1.5}}});
+    doc["extensionsUsed"] = json!(["KHR_materials_transmission", "KHR_materials_ior"]);
+    let d = dir(&format!("glass-{roughness}"));
+    std::fs::create_dir_all(&d).unwrap();
+    let path = d.join("glass.gltf");
+    std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
+    path
+}
+
+#[test]
+fn glass_in_a_furnace_neither_creates_nor_loses_energy() {
+    // Environment 1 everywhere: every pixel's expected value is 1 for smooth glass (Fresnel
+    // splits, refraction's 1/η² and η² cancel on the way in and out). Rough glass may lose
+    // the energy of single-scattering microfacets, never gain. Unlimited depth (roulette).
+    for (roughness, min_mean) in [(0.0, 0.995), (0.3, 0.93)] {
+        let path = glass_furnace(roughness);
+        let s = Settings { width: 48, height: 48, max_depth: 0, environment: Some(Vec3::ONE), ..Settings::default() };
+        let films = render_both(&path, &s, 32, "glass furnace");
+        for (backend, film) in &films {
+            let (mean, var) = film_stats(film);
+            assert_eq!(film.nonfinite_samples(), 0);
+            let n = mean.len() as f64;
+            let m: f64 = mean.iter().map(|v| v.y as f64).sum::<f64>() / n;
+            let se = (var.iter().map(|v| v.y as f64).sum::<f64>()).sqrt() / n;
+            eprintln!("glass r={roughness} {backend}: image mean {m:.4} ± {se:.4}");
+            assert!(m <= 1.0 + 4.0 * se + 1e-4, "glass r={roughness} {backend}: energy gain, mean {m} ± {se}");
+            assert!(m >= min_mean - 4.0 * se, "glass r={roughness} {backend}: mean {m} ± {se} below {min_mean}");
+        }
+        if let [(_, cpu), (_, gpu)] = &films[..] {
+            let (cm, cv) = film_stats(cpu);
+            let (gm, gv) = film_stats(gpu);
+            let a = agreement(&gm, &gv, &cm, &cv);
+            assert!(a.mean_z.abs().max_element() < 5.0, "glass r={roughness}: GPU vs CPU {a:?}");
+        }
+    }
+}
