@@ -44,7 +44,7 @@ fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 // The non-metal Fresnel: exact for transmissive materials (refraction needs the same F on
 // both sides, with total internal reflection), else Schlick with KHR_materials_specular.
 fn dielectric_fresnel(m: Material, cos_theta: f32, eta: f32) -> vec3<f32> {
-    if (m.transmission > 0.0) {
+    if (TRANSMISSION && m.transmission > 0.0) {
         return vec3<f32>(fresnel_dielectric(cos_theta, eta));
     }
     return fresnel_schlick(m.dielectric_f0, vec3<f32>(m.dielectric_f90), cos_theta);
@@ -63,6 +63,9 @@ fn diffuse_albedo(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
 
 // Estimated albedo of the transmission lobe seen from wo.
 fn transmission_albedo(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
+    if (!TRANSMISSION) {
+        return vec3<f32>(0.0);
+    }
     let f = dielectric_fresnel(m, cos_o, eta);
     return (1.0 - m.metallic) * m.transmission * m.base_color * (vec3<f32>(1.0) - f);
 }
@@ -72,7 +75,7 @@ fn transmission_albedo(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
 // macro surface, so its transmission lobe keeps at least a tenth of its weight.
 fn lobe_probabilities(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
     var wt = luminance(transmission_albedo(m, cos_o, eta));
-    if (m.roughness * m.roughness >= DELTA_ALPHA) {
+    if (TRANSMISSION && m.roughness * m.roughness >= DELTA_ALPHA) {
         wt = max(wt, 0.1 * (1.0 - m.metallic) * m.transmission * luminance(m.base_color));
     }
     let w = vec3<f32>(luminance(bsdf_fresnel(m, cos_o, eta)), luminance(diffuse_albedo(m, cos_o, eta)), wt);
@@ -119,7 +122,7 @@ fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     if (wi.z < 0.0) {
-        if (alpha < DELTA_ALPHA || m.transmission <= 0.0) {
+        if (!TRANSMISSION || alpha < DELTA_ALPHA || m.transmission <= 0.0) {
             return vec3<f32>(0.0);
         }
         let hd = refraction_half_vector(wo, wi, eta);
@@ -148,7 +151,7 @@ fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> f32 {
     let p = lobe_probabilities(m, wo.z, eta);
     let alpha = m.roughness * m.roughness;
     if (wi.z < 0.0) {
-        if (alpha < DELTA_ALPHA || p.z <= 0.0) {
+        if (!TRANSMISSION || alpha < DELTA_ALPHA || p.z <= 0.0) {
             return 0.0;
         }
         let hd = refraction_half_vector(wo, wi, eta);
@@ -188,7 +191,7 @@ fn bsdf_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample
     } else if (u.x < p.x + p.y) {
         wi = sample_cosine_hemisphere(u.yz);
     } else {
-        if (p.z <= 0.0) {
+        if (!TRANSMISSION || p.z <= 0.0) {
             return none;
         }
         var h = vec3<f32>(0.0, 0.0, 1.0);

@@ -64,7 +64,7 @@ fn trace(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
             for (var i = node.index; i < node.index + node.count; i++) {
                 let tri = triangles[i];
                 let r = intersect_triangle(ray, tri);
-                if (r.x < hit.t && ((tri.flags & TRI_ALPHA) == 0u || alpha_passes(i, r.y, r.z, ray))) {
+                if (r.x < hit.t && (!ALPHA_TEST || (tri.flags & TRI_ALPHA) == 0u || alpha_passes(i, r.y, r.z, ray))) {
                     hit = Hit(r.x, i, r.y, r.z);
                     if (any_hit) {
                         return hit;

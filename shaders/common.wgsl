@@ -9,6 +9,14 @@ const STRATEGY_LIGHT: u32 = 1u;
 const STRATEGY_MIS_BALANCE: u32 = 2u;
 const STRATEGY_MIS_POWER: u32 = 3u;
 
+// Features compiled in or out per scene (pipeline-overridable constants, set by the host from
+// what the scene uses). lavapipe runs the kernel as SIMD code where unused branches still
+// cost: an alpha test in the traversal loop alone made a scene without alpha 2.5× slower.
+override ALPHA_TEST: bool = true;
+override TEXTURES: bool = true;
+override PUNCTUAL_LIGHTS: bool = true;
+override TRANSMISSION: bool = true;
+
 struct BvhNode {
     min: vec3<f32>,
     index: u32,

@@ -61,7 +61,7 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
         let ng_raw = normalize(cross(tri.e1, tri.e2));
         let cos_hit = dot(ray.dir, ng_raw);
         // Leaving a volume through its back face: Beer–Lambert over the segment inside.
-        if (cos_hit > 0.0 && max_component(m.attenuation) > 0.0) {
+        if (TRANSMISSION && cos_hit > 0.0 && max_component(m.attenuation) > 0.0) {
             beta *= exp(-m.attenuation * hit.t);
         }
 
@@ -107,7 +107,7 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
             }
         }
         // Punctual lights: only next-event estimation can reach them, whatever the strategy.
-        if (params.punctual_count > 0u) {
+        if (PUNCTUAL_LIGHTS && params.punctual_count > 0u) {
             let ls = sample_punctual(point, rng_next(rng));
             if (ls.pdf > 0.0) {
                 let wi_local = to_local(frame, ls.wi);

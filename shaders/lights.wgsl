@@ -46,7 +46,7 @@ fn sample_light(ref_point: vec3<f32>, u: vec3<f32>) -> LightSample {
     let wi = to_light / dist;
     let cos_light = -dot(wi, normal);
     var radiance = materials[tri.material].emission;
-    if (materials[tri.material].emissive_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && materials[tri.material].emissive_texture.layer != NO_TEXTURE) {
         radiance = material_at(materials[tri.material], triangle_uv(entry.triangle, b.x, b.y)).emission;
     }
     if (cos_light <= 0.0 || dist2 <= 0.0) {

@@ -15,17 +15,17 @@ fn triangle_uv(index: u32, u: f32, v: f32) -> vec2<f32> {
 
 fn material_at(m: Material, uv: vec2<f32>) -> Material {
     var r = m;
-    if (m.base_color_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && m.base_color_texture.layer != NO_TEXTURE) {
         let c = sample_texture(m.base_color_texture, uv);
         r.base_color = m.base_color * c.xyz;
         r.alpha = m.alpha * c.w;
     }
-    if (m.metallic_roughness_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && m.metallic_roughness_texture.layer != NO_TEXTURE) {
         let c = sample_texture(m.metallic_roughness_texture, uv);
         r.roughness = m.roughness * c.y;
         r.metallic = m.metallic * c.z;
     }
-    if (m.emissive_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && m.emissive_texture.layer != NO_TEXTURE) {
         r.emission = m.emission * sample_texture(m.emissive_texture, uv).xyz;
     }
     return r;
@@ -38,7 +38,7 @@ fn alpha_passes(index: u32, u: f32, v: f32, ray: Ray) -> bool {
     let tri = triangles[index];
     let m = materials[tri.material];
     var alpha = m.alpha;
-    if (m.base_color_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && m.base_color_texture.layer != NO_TEXTURE) {
         alpha *= sample_texture(m.base_color_texture, triangle_uv(index, u, v)).w;
     }
     if ((m.flags & MAT_ALPHA_MASK) != 0u) {
@@ -69,7 +69,7 @@ fn shading_normal(tri: Triangle, index: u32, u: f32, v: f32, ng: vec3<f32>, m: M
         let len2 = dot(s, s);
         n = select(ng, s * inverseSqrt(len2), len2 > 0.0);
     }
-    if ((tri.flags & TRI_HAS_TANGENTS) == 0u || m.normal_texture.layer == NO_TEXTURE) {
+    if (!TEXTURES || (tri.flags & TRI_HAS_TANGENTS) == 0u || m.normal_texture.layer == NO_TEXTURE) {
         return n;
     }
     let t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12.x) + v * oct_decode(a.t12.y);

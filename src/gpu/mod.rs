@@ -218,7 +218,10 @@ impl GpuRenderer {
             layout: Some(&pipeline_layout),
             module: &module,
             entry_point: Some("render_sample"),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &scene.features().constants(),
+                ..Default::default()
+            },
             cache: None,
         });
         let (film_buf, readback, bind_group) =
