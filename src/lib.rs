@@ -5,6 +5,7 @@
 //! The CLI, the tests and (later) the viewer all drive [`Renderer`].
 
 pub mod accel;
+pub mod bench;
 pub mod cpu;
 pub mod film;
 pub mod gpu;

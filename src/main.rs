@@ -31,6 +31,10 @@ enum Command {
     Merge(MergeArgs),
     /// Render the seed's four direct-lighting estimators at equal spp, side by side with labels.
     Strategies(StrategiesArgs),
+    /// Benchmark: the Cornell box, the Veach scene and a generated ~260k-triangle scene on
+    /// each backend (samples/s), with load and BVH-build times, geometry bytes per triangle
+    /// and BVH traversal throughput. See BENCHMARKS.md and bench/compare-mitsuba.sh.
+    Bench(BenchArgs),
     /// List the Vulkan adapters and their limits, or describe a scene.
     Info {
         /// A .gltf/.glb file: print its triangles, meshes, instances, materials, textures,
@@ -82,6 +86,28 @@ struct MergeArgs {
     output: PathBuf,
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     exposure: f32,
+}
+
+#[derive(clap::Args)]
+struct BenchArgs {
+    #[arg(long, default_value_t = 256)]
+    width: u32,
+    #[arg(long, default_value_t = 256)]
+    height: u32,
+    #[arg(long, default_value_t = 64)]
+    spp: u32,
+    /// Path segments, as Mitsuba's max_depth (8: up to 7 bounces).
+    #[arg(long, default_value_t = 8)]
+    max_depth: u32,
+    /// Backends to run (repeat the flag for several); default: gpu and cpu.
+    #[arg(long, value_enum)]
+    backend: Vec<Backend>,
+    /// Spheres per side in the generated large scene (~16k triangles each; 4 = ~262k).
+    #[arg(long, default_value_t = 4)]
+    large_grid: u32,
+    /// Also write the results as JSON to this file.
+    #[arg(long)]
+    json: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -241,6 +267,7 @@ fn main() -> ExitCode {
         Command::Merge(args) => merge(&args),
         Command::View(args) => view(args).map(|_| Outcome::Done),
         Command::Strategies(args) => strategies(&args).map(|_| Outcome::Done),
+        Command::Bench(args) => bench(&args).map(|_| Outcome::Done),
         Command::Info { scene: Some(path) } => {
             veach::scene::gltf::describe_file(&path).map(|text| println!("{text}")).map(|_| Outcome::Done)
         }
@@ -455,6 +482,26 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
 enum Outcome {
     Done,
     Interrupted,
+}
+
+fn bench(args: &BenchArgs) -> Result<(), Error> {
+    if args.width == 0 || args.height == 0 || args.spp == 0 || args.large_grid == 0 || args.large_grid > 16 {
+        return Err(Error::Input("bench: sizes and spp must be positive, --large-grid in 1..=16".into()));
+    }
+    let backends = if args.backend.is_empty() { vec![Backend::Gpu, Backend::Cpu] } else { args.backend.clone() };
+    let opts = veach::bench::BenchOptions {
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        max_depth: args.max_depth,
+        large_grid: args.large_grid,
+    };
+    let report = veach::bench::run(&opts, &backends, &mut |line| eprintln!("veach bench: {line}"))?;
+    print!("{}", veach::bench::format_report(&report));
+    if let Some(path) = &args.json {
+        write_atomic(path, serde_json::to_string_pretty(&report).unwrap_or_default().as_bytes())?;
+    }
+    Ok(())
 }
 
 fn view(args: ViewArgs) -> Result<(), Error> {

@@ -1,0 +1,367 @@
+//! `veach bench`: a fixed set of scenes rendered with fixed settings on each backend, with
+//! load and BVH-build times, device memory per triangle, and the BVH's traversal throughput
+//! for primary, shadow and diffuse-bounce rays. Timing only: nothing here asserts.
+
+use crate::cpu::bvh::{Ray, intersect_closest, occluded, offset_ray};
+use crate::cpu::frame::{frame_from_normal, from_local};
+use crate::cpu::rng::{rng_init, rng_next2};
+use crate::cpu::sampling::{sample_cosine_hemisphere, sample_uniform_triangle};
+use crate::packed::PackedScene;
+use crate::{Backend, Error, Renderer, Settings, gpu};
+use glam::Vec3;
+use rayon::prelude::*;
+use std::time::Instant;
+
+pub const CORNELL_BOX: &[u8] = include_bytes!("../assets/cornell-box.gltf");
+pub const VEACH_MIS: &[u8] = include_bytes!("../assets/veach-mis.gltf");
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BenchOptions {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub max_depth: u32,
+    /// Spheres per side of the generated large scene's grid (each 128 × 64 segments, ~16k
+    /// triangles): 4 gives ~262k triangles, Sponza-class.
+    pub large_grid: u32,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RenderResult {
+    pub backend: String,
+    pub adapter: String,
+    pub seconds: f64,
+    pub msamples_per_second: f64,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RayResult {
+    pub kind: &'static str,
+    pub rays: usize,
+    pub seconds: f64,
+    pub mrays_per_second: f64,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SceneResult {
+    pub scene: String,
+    pub triangles: usize,
+    /// glTF parsing and flattening.
+    pub load_seconds: f64,
+    pub bvh_build_seconds: f64,
+    /// Packing the scene, BVH build included.
+    pub pack_seconds: f64,
+    pub bvh_nodes: usize,
+    /// Geometry, attributes and BVH as uploaded (nodes + triangles + vertex attributes).
+    pub geometry_bytes_per_triangle: f64,
+    pub renders: Vec<RenderResult>,
+    /// Traversal on the CPU reference's BVH walk (same nodes and order as the GPU's).
+    pub rays: Vec<RayResult>,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BenchReport {
+    pub options: BenchOptions,
+    pub machine: String,
+    pub cores: usize,
+    pub scenes: Vec<SceneResult>,
+}
+
+/// Runs the benchmark; `progress` gets one line per step.
+pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&str)) -> Result<BenchReport, Error> {
+    let large = large_scene_glb(opts.large_grid);
+    let scenes: [(&str, &[u8]); 3] =
+        [("cornell-box", CORNELL_BOX), ("veach-mis", VEACH_MIS), ("spheres-large", &large)];
+    let ctx = if backends.contains(&Backend::Gpu) { Some(gpu::GpuContext::new()?) } else { None };
+    let mut results = Vec::new();
+    for (name, bytes) in scenes {
+        progress(&format!("{name}: loading"));
+        let t = Instant::now();
+        let scene = crate::scene::gltf::load_bytes(bytes, None).map_err(|e| Error::Input(format!("{name}: {e}")))?;
+        let load_seconds = t.elapsed().as_secs_f64();
+        let camera = scene.camera(None).map_err(Error::Input)?;
+        let t = Instant::now();
+        let packed = PackedScene::new(&scene);
+        let pack_seconds = t.elapsed().as_secs_f64();
+        let tris = scene.triangles.len().max(1);
+        let geometry = std::mem::size_of_val(&packed.nodes[..])
+            + std::mem::size_of_val(&packed.triangles[..])
+            + std::mem::size_of_val(&packed.attributes[..]);
+        let mut result = SceneResult {
+            scene: name.to_string(),
+            triangles: scene.triangles.len(),
+            load_seconds,
+            bvh_build_seconds: packed.bvh_build_seconds,
+            pack_seconds,
+            bvh_nodes: packed.nodes.len(),
+            geometry_bytes_per_triangle: geometry as f64 / tris as f64,
+            renders: Vec::new(),
+            rays: Vec::new(),
+        };
+        let settings =
+            Settings { width: opts.width, height: opts.height, max_depth: opts.max_depth, ..Settings::default() };
+        for &backend in backends {
+            progress(&format!("{name}: rendering on {backend:?}"));
+            let mut r = Renderer::with_gpu(packed.clone(), &camera, &settings, backend, ctx.clone())?;
+            // One warm-up sample (shader compilation, first-touch allocations) is not timed.
+            r.render_samples(0, 1)?;
+            let t = Instant::now();
+            r.render_samples(1, opts.spp)?;
+            r.film()?;
+            let seconds = t.elapsed().as_secs_f64();
+            let samples = opts.width as f64 * opts.height as f64 * opts.spp as f64;
+            result.renders.push(RenderResult {
+                backend: format!("{backend:?}").to_lowercase(),
+                adapter: r.adapter_name(),
+                seconds,
+                msamples_per_second: samples / seconds / 1e6,
+            });
+        }
+        progress(&format!("{name}: tracing ray batches"));
+        let r = Renderer::new(packed, &camera, &settings, Backend::Cpu)?;
+        result.rays = ray_throughput(r.scene(), r.params());
+        results.push(result);
+    }
+    Ok(BenchReport {
+        options: opts.clone(),
+        machine: machine_name(),
+        cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        scenes: results,
+    })
+}
+
+/// Primary rays through every pixel; shadow rays from their hits to a point on a light
+/// (or straight up when the scene has none); cosine-distributed bounce rays from the hits.
+fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<RayResult> {
+    let (w, h) = (params.image_width, params.image_height);
+    let time = |kind: &'static str, n: usize, seconds: f64| RayResult {
+        kind,
+        rays: n,
+        seconds,
+        mrays_per_second: n as f64 / seconds.max(1e-9) / 1e6,
+    };
+    let primary: Vec<Ray> = (0..w * h)
+        .map(|i| {
+            let mut rng = rng_init(i, 0, 1);
+            let pixel = glam::UVec2::new(i % w, i / w);
+            let jitter = rng_next2(&mut rng);
+            crate::cpu::camera::generate_ray(params, pixel, jitter, &mut rng)
+        })
+        .collect();
+    let t = Instant::now();
+    let hits: Vec<_> = primary.par_iter().map(|r| intersect_closest(scene, r)).collect();
+    let primary_result = time("primary", primary.len(), t.elapsed().as_secs_f64());
+    // Surface points and their normals, facing the camera.
+    let surface: Vec<(Vec3, Vec3)> = primary
+        .iter()
+        .zip(&hits)
+        .filter(|(_, hit)| hit.tri != crate::cpu::bvh::NO_HIT)
+        .map(|(ray, hit)| {
+            let tri = &scene.triangles[hit.tri as usize];
+            let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
+            let n = e1.cross(e2).normalize();
+            let n = if n.dot(ray.dir) > 0.0 { -n } else { n };
+            let p = Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2;
+            (offset_ray(p, n), n)
+        })
+        .collect();
+    let light = scene.lights.first().map(|l| scene.triangles[l.triangle as usize]);
+    let shadow: Vec<Ray> = surface
+        .iter()
+        .enumerate()
+        .map(|(i, &(p, n))| {
+            let mut rng = rng_init(i as u32, 1, 1);
+            match light {
+                Some(tri) => {
+                    let b = sample_uniform_triangle(rng_next2(&mut rng));
+                    let q = Vec3::from(tri.p0) + b.x * Vec3::from(tri.e1) + b.y * Vec3::from(tri.e2);
+                    Ray { origin: p, dir: q - p }
+                }
+                None => Ray { origin: p, dir: n },
+            }
+        })
+        .collect();
+    let t = Instant::now();
+    let blocked = shadow.par_iter().filter(|r| occluded(scene, r, 0.999)).count();
+    let shadow_result = time("shadow", shadow.len(), t.elapsed().as_secs_f64());
+    let _ = blocked;
+    let diffuse: Vec<Ray> = surface
+        .iter()
+        .enumerate()
+        .map(|(i, &(p, n))| {
+            let mut rng = rng_init(i as u32, 2, 1);
+            Ray { origin: p, dir: from_local(&frame_from_normal(n), sample_cosine_hemisphere(rng_next2(&mut rng))) }
+        })
+        .collect();
+    let t = Instant::now();
+    let _: Vec<_> = diffuse.par_iter().map(|r| intersect_closest(scene, r)).collect();
+    let diffuse_result = time("diffuse", diffuse.len(), t.elapsed().as_secs_f64());
+    vec![primary_result, shadow_result, diffuse_result]
+}
+
+fn machine_name() -> String {
+    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    cpuinfo
+        .lines()
+        .find(|l| l.starts_with("model name"))
+        .and_then(|l| l.split(':').nth(1))
+        .map_or_else(|| std::env::consts::ARCH.to_string(), |s| s.trim().to_string())
+}
+
+/// The Cornell box's light, walls and floor with a grid × grid array of UV spheres (128 × 64
+/// segments each) standing on the floor: a generated scene of Sponza's size, as a GLB.
+pub fn large_scene_glb(grid: u32) -> Vec<u8> {
+    let mut doc: serde_json::Value = serde_json::from_slice(CORNELL_BOX).expect("bundled scene");
+    // Keep the box; replace its two blocks by the spheres.
+    let keep: Vec<serde_json::Value> = doc["scenes"][0]["nodes"]
+        .as_array()
+        .expect("nodes")
+        .iter()
+        .filter(|&n| {
+            let name = doc["nodes"][n.as_u64().unwrap_or(0) as usize]["name"].as_str().unwrap_or("");
+            !name.contains("block")
+        })
+        .cloned()
+        .collect();
+    let (nu, nv) = (128u32, 64u32);
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    let mut indices = Vec::new();
+    let spacing = 500.0 / grid as f32;
+    let radius = 0.4 * spacing;
+    for gz in 0..grid {
+        for gx in 0..grid {
+            let centre = Vec3::new(28.0 + spacing * (gx as f32 + 0.5), radius, 28.0 + spacing * (gz as f32 + 0.5));
+            let base = positions.len() as u32;
+            for j in 0..=nv {
+                let theta = std::f32::consts::PI * j as f32 / nv as f32;
+                for i in 0..=nu {
+                    let phi = 2.0 * std::f32::consts::PI * i as f32 / nu as f32;
+                    let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+                    positions.push(centre + radius * n);
+                    normals.push(n);
+                }
+            }
+            for j in 0..nv {
+                for i in 0..nu {
+                    let a = base + j * (nu + 1) + i;
+                    let b = a + nu + 1;
+                    if j > 0 {
+                        indices.extend([a, a + 1, b]);
+                    }
+                    if j + 1 < nv {
+                        indices.extend([a + 1, b + 1, b]);
+                    }
+                }
+            }
+        }
+    }
+    let mut bin: Vec<u8> = Vec::new();
+    let mut view = |bytes: &[u8]| {
+        let offset = bin.len();
+        bin.extend_from_slice(bytes);
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        (offset, bytes.len())
+    };
+    let pos_bytes: Vec<u8> = positions.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect();
+    let nrm_bytes: Vec<u8> = normals.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect();
+    let idx_bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
+    let views = [view(&pos_bytes), view(&nrm_bytes), view(&idx_bytes)];
+    let min = positions.iter().fold(Vec3::INFINITY, |a, &p| a.min(p));
+    let max = positions.iter().fold(Vec3::NEG_INFINITY, |a, &p| a.max(p));
+    // The bundled file's own buffers stay (embedded); the spheres' buffer is the GLB's BIN
+    // chunk, which must be buffer 0: the others move up by one.
+    let buffer = 0;
+    for v in doc["bufferViews"].as_array_mut().expect("views") {
+        v["buffer"] = serde_json::json!(v["buffer"].as_u64().unwrap_or(0) + 1);
+    }
+    let view0 = doc["bufferViews"].as_array().map_or(0, |b| b.len());
+    let acc0 = doc["accessors"].as_array().map_or(0, |b| b.len());
+    doc["buffers"].as_array_mut().expect("buffers").insert(0, serde_json::json!({"byteLength": bin.len()}));
+    for (offset, len) in views {
+        doc["bufferViews"]
+            .as_array_mut()
+            .expect("views")
+            .push(serde_json::json!({"buffer": buffer, "byteOffset": offset, "byteLength": len}));
+    }
+    let accessors = doc["accessors"].as_array_mut().expect("accessors");
+    accessors.push(serde_json::json!({"bufferView": view0, "componentType": 5126, "count": positions.len(),
+        "type": "VEC3", "min": min.to_array(), "max": max.to_array()}));
+    accessors.push(
+        serde_json::json!({"bufferView": view0 + 1, "componentType": 5126, "count": normals.len(), "type": "VEC3"}),
+    );
+    accessors.push(
+        serde_json::json!({"bufferView": view0 + 2, "componentType": 5125, "count": indices.len(), "type": "SCALAR"}),
+    );
+    let materials = doc["materials"].as_array_mut().expect("materials");
+    materials
+        .push(serde_json::json!({"name": "spheres", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1.0],
+        "metallicFactor": 0.0, "roughnessFactor": 0.5}}));
+    let material = materials.len() - 1;
+    let meshes = doc["meshes"].as_array_mut().expect("meshes");
+    meshes.push(
+        serde_json::json!({"name": "spheres", "primitives": [{"attributes": {"POSITION": acc0, "NORMAL": acc0 + 1},
+        "indices": acc0 + 2, "material": material}]}),
+    );
+    let mesh = meshes.len() - 1;
+    let nodes = doc["nodes"].as_array_mut().expect("nodes");
+    nodes.push(serde_json::json!({"name": "spheres", "mesh": mesh}));
+    let mut roots = keep;
+    roots.push(serde_json::json!(nodes.len() - 1));
+    doc["scenes"][0]["nodes"] = serde_json::Value::Array(roots);
+    let mut json = serde_json::to_vec(&doc).expect("json");
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut glb = Vec::with_capacity(total);
+    glb.extend_from_slice(b"glTF");
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&(total as u32).to_le_bytes());
+    glb.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    glb.extend_from_slice(&0x4E4F534Au32.to_le_bytes());
+    glb.extend_from_slice(&json);
+    glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    glb.extend_from_slice(&0x004E4942u32.to_le_bytes());
+    glb.extend_from_slice(&bin);
+    glb
+}
+
+/// The report as an aligned text table.
+pub fn format_report(r: &BenchReport) -> String {
+    let o = &r.options;
+    let mut s = format!(
+        "veach bench: {}x{}, {} spp, max depth {}; {} ({} cores)\n\n",
+        o.width, o.height, o.spp, o.max_depth, r.machine, r.cores
+    );
+    s += &format!(
+        "{:<14} {:>9} {:>9} {:>9} {:>9} {:>8}  {:<8} {:>10} {:>9}\n",
+        "scene", "triangles", "load s", "BVH s", "nodes", "B/tri", "backend", "Msamples/s", "seconds"
+    );
+    for sc in &r.scenes {
+        for (i, run) in sc.renders.iter().enumerate() {
+            let head = if i == 0 {
+                format!(
+                    "{:<14} {:>9} {:>9.3} {:>9.3} {:>9} {:>8.1}",
+                    sc.scene,
+                    sc.triangles,
+                    sc.load_seconds,
+                    sc.bvh_build_seconds,
+                    sc.bvh_nodes,
+                    sc.geometry_bytes_per_triangle
+                )
+            } else {
+                format!("{:<14} {:>9} {:>9} {:>9} {:>9} {:>8}", "", "", "", "", "", "")
+            };
+            s += &format!("{head}  {:<8} {:>10.3} {:>9.2}\n", run.backend, run.msamples_per_second, run.seconds);
+        }
+    }
+    s += "\nBVH traversal on the CPU reference (M rays/s): primary / shadow / diffuse bounce\n";
+    for sc in &r.scenes {
+        let m: Vec<String> = sc.rays.iter().map(|x| format!("{:.2}", x.mrays_per_second)).collect();
+        s += &format!("{:<14} {}\n", sc.scene, m.join(" / "));
+    }
+    s
+}
