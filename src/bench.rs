@@ -260,7 +260,7 @@ pub fn large_scene_glb(grid: u32) -> Vec<u8> {
     let mut view = |bytes: &[u8]| {
         let offset = bin.len();
         bin.extend_from_slice(bytes);
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         (offset, bytes.len())
@@ -312,7 +312,7 @@ pub fn large_scene_glb(grid: u32) -> Vec<u8> {
     roots.push(serde_json::json!(nodes.len() - 1));
     doc["scenes"][0]["nodes"] = serde_json::Value::Array(roots);
     let mut json = serde_json::to_vec(&doc).expect("json");
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let total = 12 + 8 + json.len() + 8 + bin.len();
