@@ -13,6 +13,7 @@ pub mod label;
 pub mod output;
 pub mod packed;
 pub mod params;
+pub mod plot;
 pub mod scene;
 pub mod tonemap;
 pub mod viewer;

@@ -31,6 +31,9 @@ enum Command {
     Merge(MergeArgs),
     /// Render the seed's four direct-lighting estimators at equal spp, side by side with labels.
     Strategies(StrategiesArgs),
+    /// Plot RMSE against render time (log-log) for renders made with --reference and
+    /// --stats-json: compare samplers, estimators and backends at equal time.
+    PlotConvergence(PlotArgs),
     /// Benchmark: the Cornell box, the Veach scene and a generated ~260k-triangle scene on
     /// each backend (samples/s), with load and BVH-build times, geometry bytes per triangle
     /// and BVH traversal throughput. See BENCHMARKS.md and bench/compare-mitsuba.sh.
@@ -86,6 +89,25 @@ struct MergeArgs {
     output: PathBuf,
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     exposure: f32,
+}
+
+#[derive(clap::Args)]
+struct PlotArgs {
+    /// Statistics files written by `veach render --reference REF.exr --stats-json FILE`.
+    #[arg(required = true)]
+    stats: Vec<PathBuf>,
+    /// The plot (.png).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Horizontal axis: render seconds (equal-time comparison) or samples per pixel.
+    #[arg(long, value_enum, default_value_t = PlotX::Seconds)]
+    x: PlotX,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum PlotX {
+    Seconds,
+    Spp,
 }
 
 #[derive(clap::Args)]
@@ -221,6 +243,10 @@ struct RenderArgs {
     /// Write render statistics as JSON.
     #[arg(long)]
     stats_json: Option<PathBuf>,
+    /// A converged image of the same size (EXR): record the RMSE against it at 1, 2, 4, ...
+    /// spp and the end, with the render time, in --stats-json ("convergence").
+    #[arg(long)]
+    reference: Option<PathBuf>,
 }
 
 fn parse_range(s: &str) -> Result<(u32, u32), String> {
@@ -268,6 +294,7 @@ fn main() -> ExitCode {
         Command::View(args) => view(args).map(|_| Outcome::Done),
         Command::Strategies(args) => strategies(&args).map(|_| Outcome::Done),
         Command::Bench(args) => bench(&args).map(|_| Outcome::Done),
+        Command::PlotConvergence(args) => plot_convergence(&args).map(|_| Outcome::Done),
         Command::Info { scene: Some(path) } => {
             veach::scene::gltf::describe_file(&path).map(|text| println!("{text}")).map(|_| Outcome::Done)
         }
@@ -389,6 +416,13 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
         renderer.set_film(&film);
     }
     let total = job.sample_end - job.sample_start;
+    let reference = match &args.reference {
+        Some(path) => Some(read_reference(path, job.window())?),
+        None => None,
+    };
+    let mut convergence = Vec::new();
+    let mut measuring = std::time::Duration::ZERO;
+    let mut next_measure = (done + 1).next_power_of_two();
     // Ctrl-C and SIGTERM stop the loop between dispatches; the work done is kept.
     let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
 
@@ -404,13 +438,27 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
     let mut last_checkpoint = Instant::now();
     let (mut chunk, first) = (1u32, done);
     while done < total && !INTERRUPTED.load(Ordering::SeqCst) {
-        let n = chunk.min(total - done);
+        let mut n = chunk.min(total - done);
+        if reference.is_some() {
+            n = n.min(next_measure - done);
+        }
         let t = Instant::now();
         renderer.render_samples(job.sample_start + done, n)?;
         done += n;
         // Aim for about a quarter second per chunk: responsive to Ctrl-C, few round trips.
         let secs = t.elapsed().as_secs_f64().max(1e-6);
         chunk = ((n as f64 * 0.25 / secs) as u32).clamp(1, veach::gpu::MAX_BATCH);
+        if let Some(r) = &reference
+            && (done == next_measure || done == total)
+        {
+            // The readback and the error are not render time.
+            let t = Instant::now();
+            let rmse = rmse(&renderer.film()?, r);
+            measuring += t.elapsed();
+            let seconds = (t_render.elapsed() - measuring).as_secs_f64();
+            convergence.push(serde_json::json!({"spp": done, "seconds": seconds, "rmse": rmse}));
+            next_measure = (done + 1).next_power_of_two();
+        }
         bar.set_position(done as u64);
         let rate = (done - first) as f64 * pixels / t_render.elapsed().as_secs_f64().max(1e-9);
         bar.set_message(format!("{:.2} Msamples/s", rate / 1e6));
@@ -424,7 +472,7 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
     }
     let interrupted = done < total;
     let film = renderer.film()?;
-    let seconds_render = t_render.elapsed().as_secs_f64();
+    let seconds_render = (t_render.elapsed() - measuring).as_secs_f64();
     bar.finish_and_clear();
     veach::output::write_with(&film, &args.output, args.exposure, args.tonemap, Some(&job))?;
     if let Some(path) = &args.checkpoint {
@@ -473,15 +521,86 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
             "bvh_build_seconds": bvh_seconds,
             "nonfinite_samples": nonfinite,
             "gpu_bytes": renderer.gpu_bytes(),
+            "reference": args.reference.as_ref().map(|p| p.display().to_string()),
+            "convergence": convergence,
         });
         write_atomic(path, serde_json::to_string_pretty(&stats).unwrap_or_default().as_bytes())?;
     }
     Ok(if interrupted { Outcome::Interrupted } else { Outcome::Done })
 }
 
+/// The reference image for --reference, as linear RGB per pixel of the render window.
+fn read_reference(path: &Path, window: Tile) -> Result<Vec<Vec3>, Error> {
+    let (w, h, v) = veach::output::read_exr(path)?;
+    if (w, h) != (window.width, window.height) {
+        return Err(Error::Input(format!(
+            "{}: the reference is {w}x{h}, the render {}x{}",
+            path.display(),
+            window.width,
+            window.height
+        )));
+    }
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err(Error::Input(format!("{}: the reference has non-finite pixels", path.display())));
+    }
+    Ok(v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect())
+}
+
+/// Root-mean-square error of the film's mean against a reference, over pixels and channels.
+fn rmse(film: &Film, reference: &[Vec3]) -> f64 {
+    let sum: f64 = reference
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let d = (film.mean(i) - *r).as_dvec3();
+            d.dot(d)
+        })
+        .sum();
+    (sum / (3.0 * reference.len().max(1) as f64)).sqrt()
+}
+
 enum Outcome {
     Done,
     Interrupted,
+}
+
+fn plot_convergence(args: &PlotArgs) -> Result<(), Error> {
+    if veach::output::check_output(&args.output)? != veach::output::Format::Png {
+        return Err(Error::Input(format!("{}: the plot is a .png", args.output.display())));
+    }
+    let mut series = Vec::new();
+    for path in &args.stats {
+        let fail = |m: &str| Error::Input(format!("{}: {m}", path.display()));
+        let text = std::fs::read_to_string(path).map_err(|e| fail(&format!("cannot read: {e}")))?;
+        let stats: serde_json::Value = serde_json::from_str(&text).map_err(|e| fail(&format!("invalid JSON: {e}")))?;
+        let points = stats["convergence"]
+            .as_array()
+            .ok_or_else(|| fail("no \"convergence\" series (render with --reference and --stats-json)"))?;
+        let key = match args.x {
+            PlotX::Seconds => "seconds",
+            PlotX::Spp => "spp",
+        };
+        let points: Vec<(f64, f64)> =
+            points.iter().filter_map(|p| Some((p[key].as_f64()?, p["rmse"].as_f64()?))).collect();
+        if points.is_empty() {
+            return Err(fail("the convergence series is empty"));
+        }
+        let stem = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().to_string());
+        let what = [&stats["backend"], &stats["strategy"]]
+            .iter()
+            .filter_map(|v| v.as_str().map(str::to_string))
+            .collect::<Vec<_>>()
+            .join(" ");
+        series.push(veach::plot::Series { label: format!("{stem} ({what})"), points });
+    }
+    let x_label = match args.x {
+        PlotX::Seconds => "RENDER TIME (S)",
+        PlotX::Spp => "SAMPLES PER PIXEL",
+    };
+    let img = veach::plot::plot_loglog(&series, x_label, "RMSE");
+    veach::output::write_png(&img, &args.output)?;
+    eprintln!("veach: wrote {}", args.output.display());
+    Ok(())
 }
 
 fn bench(args: &BenchArgs) -> Result<(), Error> {

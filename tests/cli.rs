@@ -238,3 +238,98 @@ fn without_a_vulkan_driver_falls_back_to_cpu_or_says_how_to_get_one() {
     assert_user_error(&veach(&explicit, &no_driver), "apt-get install mesa-vulkan-drivers");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn reference_records_convergence_and_plots_it() {
+    let d = temp_dir("convergence");
+    let cbox = common::asset("cornell-box.gltf");
+    // Mitsuba's Cornell box at depth 8 (tests/data), the render at the same size.
+    let reference = common::root().join("tests/data/cbox_d8_64.exr");
+    let mut stats = Vec::new();
+    for strategy in ["mis-power", "bsdf"] {
+        let json = d.join(format!("{strategy}.json"));
+        let out = veach(
+            &[
+                "render",
+                cbox.to_str().unwrap(),
+                "--backend",
+                "cpu",
+                "--width",
+                "64",
+                "--height",
+                "64",
+                "--spp",
+                "32",
+                "--strategy",
+                strategy,
+                "--reference",
+                reference.to_str().unwrap(),
+                "--stats-json",
+                json.to_str().unwrap(),
+                "-o",
+                d.join(format!("{strategy}.exr")).to_str().unwrap(),
+            ],
+            &[],
+        );
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+        let series = v["convergence"].as_array().expect("convergence series");
+        let spp: Vec<u64> = series.iter().map(|p| p["spp"].as_u64().unwrap()).collect();
+        assert_eq!(spp, [1, 2, 4, 8, 16, 32]);
+        let rmse: Vec<f64> = series.iter().map(|p| p["rmse"].as_f64().unwrap()).collect();
+        let seconds: Vec<f64> = series.iter().map(|p| p["seconds"].as_f64().unwrap()).collect();
+        assert!(seconds.windows(2).all(|w| w[1] >= w[0]), "{seconds:?}");
+        // Noise dominates: 32× the samples must cut the error by well over half (1/√32 ≈ 0.18).
+        assert!(rmse[5] < 0.6 * rmse[0], "{strategy}: {rmse:?}");
+        stats.push(json);
+    }
+    // MIS beats BSDF sampling on the same samples.
+    let last = |p: &PathBuf| {
+        let v: serde_json::Value = serde_json::from_slice(&std::fs::read(p).unwrap()).unwrap();
+        v["convergence"].as_array().unwrap().last().unwrap()["rmse"].as_f64().unwrap()
+    };
+    assert!(last(&stats[0]) < last(&stats[1]), "MIS {} vs BSDF {}", last(&stats[0]), last(&stats[1]));
+
+    let plot = d.join("plot.png");
+    let args: Vec<&str> = ["plot-convergence", stats[0].to_str().unwrap(), stats[1].to_str().unwrap(), "-o"]
+        .into_iter()
+        .chain([plot.to_str().unwrap()])
+        .collect();
+    let out = veach(&args, &[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&plot).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (900, 560));
+    // Both series are drawn in their colours.
+    for colour in [[31u8, 119, 180], [214, 39, 40]] {
+        assert!(img.pixels().filter(|p| p.0 == colour).count() > 200, "series {colour:?} missing");
+    }
+
+    // A stats file without a series, and a reference of the wrong size: one line, exit 2.
+    let bare = d.join("bare.json");
+    std::fs::write(&bare, b"{}").unwrap();
+    assert_user_error(
+        &veach(&["plot-convergence", bare.to_str().unwrap(), "-o", plot.to_str().unwrap()], &[]),
+        "bare.json",
+    );
+    let out = veach(
+        &[
+            "render",
+            cbox.to_str().unwrap(),
+            "--backend",
+            "cpu",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--spp",
+            "1",
+            "--reference",
+            reference.to_str().unwrap(),
+            "-o",
+            d.join("x.png").to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_user_error(&out, "cbox_d8_64.exr");
+    let _ = std::fs::remove_dir_all(&d);
+}
