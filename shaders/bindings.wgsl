@@ -5,9 +5,9 @@
 // uniform: lavapipe (Mesa 22.3) inlines uniform values into the shader and compiled, and
 // kept, a new variant on every dispatch: 12 ms and 1.3 MB each (BENCHMARKS.md).
 @group(0) @binding(0) var<storage, read> params: Params;
-@group(0) @binding(1) var<storage, read> nodes: array<BvhNode>;
-@group(0) @binding(2) var<storage, read> triangles: array<Triangle>;
-@group(0) @binding(3) var<storage, read> attributes: array<Attributes>;
+// Bindings 1–3 (BVH nodes, triangles, vertex attributes) and their load_* functions: storage
+// buffers, or for scenes beyond a storage binding's limit, textures (see geometry.wgsl).
+#include "geometry.wgsl"
 @group(0) @binding(4) var<storage, read> materials: array<Material>;
 @group(0) @binding(5) var<storage, read> lights: array<LightEntry>;
 // Three rows per pixel (see film.wgsl): (Σ L high words, count), (Σ L low words, dropped

@@ -55,14 +55,14 @@ fn trace(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
     var stack: array<u32, STACK_SIZE>;
     var sp = 0u;
     var index = 0u;
-    if (intersect_node(nodes[0], ray.origin, inv_dir, hit.t) == INF) {
+    if (intersect_node(load_node(0), ray.origin, inv_dir, hit.t) == INF) {
         return hit;
     }
     loop {
-        let node = nodes[index];
+        let node = load_node(index);
         if (node.count > 0u) {
             for (var i = node.index; i < node.index + node.count; i++) {
-                let tri = triangles[i];
+                let tri = load_triangle(i);
                 let r = intersect_triangle(ray, tri);
                 if (r.x < hit.t && (!ALPHA_TEST || (tri.flags & TRI_ALPHA) == 0u || alpha_passes(i, r.y, r.z, ray))) {
                     hit = Hit(r.x, i, r.y, r.z);
@@ -74,8 +74,8 @@ fn trace(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
         } else {
             let left = node.index;
             let right = node.index + 1u;
-            let t_left = intersect_node(nodes[left], ray.origin, inv_dir, hit.t);
-            let t_right = intersect_node(nodes[right], ray.origin, inv_dir, hit.t);
+            let t_left = intersect_node(load_node(left), ray.origin, inv_dir, hit.t);
+            let t_right = intersect_node(load_node(right), ray.origin, inv_dir, hit.t);
             if (t_left != INF && t_right != INF) {
                 let near_is_left = t_left <= t_right;
                 if (sp < STACK_SIZE) {

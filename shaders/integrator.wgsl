@@ -54,7 +54,7 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
             radiance += beta * environment_radiance(ray.dir) * w;
             break;
         }
-        let tri = triangles[hit.tri];
+        let tri = load_triangle(hit.tri);
         let uv = triangle_uv(hit.tri, hit.u, hit.v);
         let m = material_at(materials[tri.material], uv);
         let point = tri.p0 + hit.u * tri.e1 + hit.v * tri.e2;

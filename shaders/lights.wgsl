@@ -36,7 +36,7 @@ fn sample_light(ref_point: vec3<f32>, u: vec3<f32>) -> LightSample {
     if (scaled - f32(slot) >= entry.prob) {
         entry = lights[entry.alias_slot];
     }
-    let tri = triangles[entry.triangle];
+    let tri = load_triangle(entry.triangle);
     let b = sample_uniform_triangle(u.yz);
     let point = tri.p0 + b.x * tri.e1 + b.y * tri.e2;
     let normal = normalize(cross(tri.e1, tri.e2));

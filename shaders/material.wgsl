@@ -9,7 +9,7 @@
 
 // TEXCOORD_0 at barycentrics (u, v) of vertices 1 and 2.
 fn triangle_uv(index: u32, u: f32, v: f32) -> vec2<f32> {
-    let a = attributes[index];
+    let a = load_attributes(index);
     return (1.0 - u - v) * a.uv0 + u * a.uv1 + v * a.uv2;
 }
 
@@ -35,7 +35,7 @@ fn material_at(m: Material, uv: vec2<f32>) -> Material {
 // probability alpha (stochastic transparency), decided by a hash of the ray and the triangle
 // so that the decision is the same for the closest-hit and the shadow query of one ray.
 fn alpha_passes(index: u32, u: f32, v: f32, ray: Ray) -> bool {
-    let tri = triangles[index];
+    let tri = load_triangle(index);
     let m = materials[tri.material];
     var alpha = m.alpha;
     if (TEXTURES && m.base_color_texture.layer != NO_TEXTURE) {
@@ -63,7 +63,7 @@ fn oct_decode(bits: u32) -> vec3<f32> {
 // normal map: n' = T·x + B·y + N·z with T Gram-Schmidt'd against N and B = cross(N, T)·w.
 fn shading_normal(tri: Triangle, index: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec2<f32>) -> vec3<f32> {
     var n = ng;
-    let a = attributes[index];
+    let a = load_attributes(index);
     if ((tri.flags & TRI_HAS_NORMALS) != 0u) {
         let s = (1.0 - u - v) * oct_decode(a.n.x) + u * oct_decode(a.n.y) + v * oct_decode(a.n.z);
         let len2 = dot(s, s);

@@ -604,8 +604,8 @@ fn plot_convergence(args: &PlotArgs) -> Result<(), Error> {
 }
 
 fn bench(args: &BenchArgs) -> Result<(), Error> {
-    if args.width == 0 || args.height == 0 || args.spp == 0 || args.large_grid == 0 || args.large_grid > 16 {
-        return Err(Error::Input("bench: sizes and spp must be positive, --large-grid in 1..=16".into()));
+    if args.width == 0 || args.height == 0 || args.spp == 0 || args.large_grid == 0 || args.large_grid > 32 {
+        return Err(Error::Input("bench: sizes and spp must be positive, --large-grid in 1..=32".into()));
     }
     let backends = if args.backend.is_empty() { vec![Backend::Gpu, Backend::Cpu] } else { args.backend.clone() };
     let opts = veach::bench::BenchOptions {

@@ -1,6 +1,6 @@
 //! Every WGSL file, after the include step, parses and validates with naga (no GPU needed).
 
-use veach::gpu::shaders::{INTEGRATOR, SOURCES, compose};
+use veach::gpu::shaders::{Geometry, INTEGRATOR, SOURCES, compose, compose_with};
 
 fn validate(name: &str) -> naga::Module {
     let src = compose(name).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -30,6 +30,16 @@ fn integrator_kernel_fits_default_limits() {
         module.global_variables.iter().filter(|(_, g)| matches!(g.space, naga::AddressSpace::Storage { .. })).count()
             as u32;
     assert!(storage <= limits.max_storage_buffers_per_shader_stage, "{storage} storage buffers");
+}
+
+#[test]
+fn paged_geometry_kernel_validates() {
+    let src = compose_with(INTEGRATOR, Geometry::Textures).unwrap();
+    let module = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+    assert!(src.contains("triangle_texels") && !src.contains("array<Triangle>"));
 }
 
 #[test]

@@ -110,6 +110,9 @@ pub struct GpuRenderer {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     scene: [wgpu::Buffer; 6],
+    /// Nodes, triangles and attributes as textures (bindings 1–3) when the scene is beyond a
+    /// storage binding; `scene[0..3]` are then unused placeholders.
+    geometry: Option<[wgpu::TextureView; 3]>,
     textures: wgpu::TextureView,
     bind_group: wgpu::BindGroup,
     params_buf: wgpu::Buffer,
@@ -143,10 +146,20 @@ impl GpuRenderer {
                 usage: wgpu::BufferUsages::STORAGE,
             }))
         };
+        let geometry_bytes: [&[u8]; 3] = [
+            bytemuck::cast_slice(&scene.nodes),
+            bytemuck::cast_slice(&scene.triangles),
+            bytemuck::cast_slice(&scene.attributes),
+        ];
+        let paged = std::env::var("VEACH_GEOMETRY").as_deref() == Ok("textures")
+            || geometry_bytes.iter().any(|b| b.len() as u64 > limits.max_storage_buffer_binding_size);
+        let geometry = if paged { Some(Self::geometry_textures(&ctx, geometry_bytes)?) } else { None };
+        let placeholder: [&[u8]; 3] = [&[], &[], &[]];
+        let geometry_buffers = if paged { placeholder } else { geometry_bytes };
         let scene_buffers = [
-            storage("bvh nodes", bytemuck::cast_slice(&scene.nodes))?,
-            storage("triangles", bytemuck::cast_slice(&scene.triangles))?,
-            storage("vertex attributes", bytemuck::cast_slice(&scene.attributes))?,
+            storage("bvh nodes", geometry_buffers[0])?,
+            storage("triangles", geometry_buffers[1])?,
+            storage("vertex attributes", geometry_buffers[2])?,
             storage("materials", bytemuck::cast_slice(&scene.materials))?,
             storage("lights", bytemuck::cast_slice(&scene.lights))?,
             storage("light data", bytemuck::cast_slice(&scene.env))?,
@@ -162,7 +175,8 @@ impl GpuRenderer {
             mapped_at_creation: false,
         });
 
-        let source = shaders::compose(shaders::INTEGRATOR).map_err(Error::Gpu)?;
+        let variant = if paged { shaders::Geometry::Textures } else { shaders::Geometry::Buffers };
+        let source = shaders::compose_with(shaders::INTEGRATOR, variant).map_err(Error::Gpu)?;
         let descriptor =
             wgpu::ShaderModuleDescriptor { label: Some("integrator"), source: wgpu::ShaderSource::Wgsl(source.into()) };
         let module = device.create_shader_module(descriptor);
@@ -189,9 +203,9 @@ impl GpuRenderer {
                     },
                     count: None,
                 },
-                storage_entry(1, true),
-                storage_entry(2, true),
-                storage_entry(3, true),
+                geometry_entry(1, paged),
+                geometry_entry(2, paged),
+                geometry_entry(3, paged),
                 storage_entry(4, true),
                 storage_entry(5, true),
                 storage_entry(6, false),
@@ -225,15 +239,18 @@ impl GpuRenderer {
             cache: None,
         });
         let (film_buf, readback, bind_group) =
-            Self::film(&ctx, &layout, &scene_buffers, &textures, &params_buf, params)?;
-        let gpu_bytes =
-            scene_buffers.iter().chain([&film_buf, &params_buf]).map(|b| b.size()).sum::<u64>() + texture_bytes;
+            Self::film(&ctx, &layout, &scene_buffers, geometry.as_ref(), &textures, &params_buf, params)?;
+        let paged_bytes = if paged { geometry_bytes.iter().map(|b| b.len() as u64).sum() } else { 0 };
+        let gpu_bytes = scene_buffers.iter().chain([&film_buf, &params_buf]).map(|b| b.size()).sum::<u64>()
+            + texture_bytes
+            + paged_bytes;
         ctx.check()?;
         Ok(GpuRenderer {
             ctx,
             pipeline,
             layout,
             scene: scene_buffers,
+            geometry,
             textures,
             bind_group,
             params_buf,
@@ -243,6 +260,46 @@ impl GpuRenderer {
             params,
             gpu_bytes,
         })
+    }
+
+    /// Geometry records paged into rgba32uint textures, 4096 texels a row
+    /// (shaders/geometry_textures.wgsl).
+    fn geometry_textures(ctx: &GpuContext, data: [&[u8]; 3]) -> Result<[wgpu::TextureView; 3], Error> {
+        const ROW: usize = 4096;
+        let limits = ctx.device.limits();
+        let names = ["BVH nodes", "triangles", "vertex attributes"];
+        let mut views = Vec::new();
+        for (bytes, name) in data.iter().zip(names) {
+            let texels = bytes.len().div_ceil(16).max(1);
+            let rows = texels.div_ceil(ROW);
+            if rows as u64 > limits.max_texture_dimension_2d as u64 {
+                return Err(Error::Limit(format!(
+                    "the scene's {name} need {rows} texture rows of {ROW} texels, above the device's \
+                     max_texture_dimension_2d = {}",
+                    limits.max_texture_dimension_2d
+                )));
+            }
+            let mut padded = bytes.to_vec();
+            padded.resize(rows * ROW * 16, 0);
+            let texture = ctx.device.create_texture_with_data(
+                &ctx.queue,
+                &wgpu::TextureDescriptor {
+                    label: Some(name),
+                    size: wgpu::Extent3d { width: ROW as u32, height: rows as u32, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::Rgba32Uint,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                },
+                wgpu::util::TextureDataOrder::LayerMajor,
+                &padded,
+            );
+            views.push(texture.create_view(&Default::default()));
+        }
+        let [a, b, c]: [wgpu::TextureView; 3] = views.try_into().map_err(|_| Error::Gpu("geometry views".into()))?;
+        Ok([a, b, c])
     }
 
     /// The scene's images as one texture array (RGBA8, one square layer per image).
@@ -283,6 +340,7 @@ impl GpuRenderer {
         ctx: &GpuContext,
         layout: &wgpu::BindGroupLayout,
         scene: &[wgpu::Buffer; 6],
+        geometry: Option<&[wgpu::TextureView; 3]>,
         textures: &wgpu::TextureView,
         params_buf: &wgpu::Buffer,
         params: Params,
@@ -317,9 +375,9 @@ impl GpuRenderer {
                         size: wgpu::BufferSize::new(params_size),
                     }),
                 },
-                entry(1, &scene[0]),
-                entry(2, &scene[1]),
-                entry(3, &scene[2]),
+                geometry_binding(1, &scene[0], geometry.map(|g| &g[0])),
+                geometry_binding(2, &scene[1], geometry.map(|g| &g[1])),
+                geometry_binding(3, &scene[2], geometry.map(|g| &g[2])),
                 entry(4, &scene[3]),
                 entry(5, &scene[4]),
                 entry(6, &film_buf),
@@ -333,8 +391,15 @@ impl GpuRenderer {
     /// New parameters (camera, settings, window) and an empty film: the viewer's restart.
     pub fn reset(&mut self, params: Params) -> Result<(), Error> {
         if (params.film_width, params.film_height) != (self.params.film_width, self.params.film_height) {
-            let (film, readback, bind_group) =
-                Self::film(&self.ctx, &self.layout, &self.scene, &self.textures, &self.params_buf, params)?;
+            let (film, readback, bind_group) = Self::film(
+                &self.ctx,
+                &self.layout,
+                &self.scene,
+                self.geometry.as_ref(),
+                &self.textures,
+                &self.params_buf,
+                params,
+            )?;
             (self.film_buf, self.readback, self.bind_group) = (film, readback, bind_group);
         } else {
             let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
@@ -437,6 +502,35 @@ impl GpuRenderer {
         }
         self.readback.unmap();
         Ok(film)
+    }
+}
+
+/// Layout of a geometry binding: a read-only storage buffer, or a u32 texture when paged.
+fn geometry_entry(binding: u32, paged: bool) -> wgpu::BindGroupLayoutEntry {
+    let ty = if paged {
+        wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Uint,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        }
+    } else {
+        wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        }
+    };
+    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
+}
+
+fn geometry_binding<'a>(
+    binding: u32,
+    buffer: &'a wgpu::Buffer,
+    view: Option<&'a wgpu::TextureView>,
+) -> wgpu::BindGroupEntry<'a> {
+    match view {
+        Some(v) => wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) },
+        None => entry(binding, buffer),
     }
 }
 

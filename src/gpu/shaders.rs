@@ -9,6 +9,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("sampling.wgsl", include_str!("../../shaders/sampling.wgsl")),
     ("frame.wgsl", include_str!("../../shaders/frame.wgsl")),
     ("mis.wgsl", include_str!("../../shaders/mis.wgsl")),
+    ("geometry_buffers.wgsl", include_str!("../../shaders/geometry_buffers.wgsl")),
+    ("geometry_textures.wgsl", include_str!("../../shaders/geometry_textures.wgsl")),
     ("texture.wgsl", include_str!("../../shaders/texture.wgsl")),
     ("material.wgsl", include_str!("../../shaders/material.wgsl")),
     ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
@@ -27,15 +29,40 @@ pub const SOURCES: &[(&str, &str)] = &[
 pub const INTEGRATOR: &str = "integrator.wgsl";
 pub const DISPLAY: &str = "display.wgsl";
 
-/// Composes `entry` and everything it includes into one WGSL source.
+/// Where the kernel reads scene geometry from: `#include "geometry.wgsl"` resolves to one of
+/// two files with the same load_* functions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Geometry {
+    /// Storage buffers (fastest; each binding at most max_storage_buffer_binding_size).
+    Buffers,
+    /// 2D textures of 16-byte texels, for scenes beyond a storage binding.
+    Textures,
+}
+
+/// Composes `entry` and everything it includes into one WGSL source (geometry in buffers).
 pub fn compose(entry: &str) -> Result<String, String> {
+    compose_with(entry, Geometry::Buffers)
+}
+
+pub fn compose_with(entry: &str, geometry: Geometry) -> Result<String, String> {
     let mut out = String::new();
     let mut included = Vec::new();
-    include(entry, &mut included, &mut out, 0)?;
+    include(entry, geometry, &mut included, &mut out, 0)?;
     Ok(out)
 }
 
-fn include(name: &str, included: &mut Vec<String>, out: &mut String, depth: usize) -> Result<(), String> {
+fn include(
+    name: &str,
+    geometry: Geometry,
+    included: &mut Vec<String>,
+    out: &mut String,
+    depth: usize,
+) -> Result<(), String> {
+    let name = match (name, geometry) {
+        ("geometry.wgsl", Geometry::Buffers) => "geometry_buffers.wgsl",
+        ("geometry.wgsl", Geometry::Textures) => "geometry_textures.wgsl",
+        (n, _) => n,
+    };
     if included.iter().any(|n| n == name) {
         return Ok(());
     }
@@ -48,7 +75,7 @@ fn include(name: &str, included: &mut Vec<String>, out: &mut String, depth: usiz
     out.push_str(&format!("// ---- {name}\n"));
     for line in source.lines() {
         match line.trim().strip_prefix("#include") {
-            Some(rest) => include(rest.trim().trim_matches('"'), included, out, depth + 1)?,
+            Some(rest) => include(rest.trim().trim_matches('"'), geometry, included, out, depth + 1)?,
             None => {
                 out.push_str(line);
                 out.push('\n');
