@@ -3,6 +3,7 @@
 // the surface is not there. Twin: src/cpu/bvh.rs.
 #include "bindings.wgsl"
 #include "material.wgsl"
+#include "instance.wgsl"
 
 const NO_HIT: u32 = 0xffffffffu;
 const STACK_SIZE: u32 = 64u;
@@ -13,6 +14,8 @@ struct Hit {
     // Barycentrics of vertices 1 and 2.
     u: f32,
     v: f32,
+    // Instance record of the hit (with instancing).
+    instance: u32,
 }
 
 // Distance along the ray (t, u, v), or t = INF on a miss.
@@ -48,14 +51,15 @@ fn intersect_node(node: BvhNode, origin: vec3<f32>, inv_dir: vec3<f32>, t_max: f
     return select(INF, t_enter, t_enter <= t_exit);
 }
 
-// Closest hit with t < t_max; `any_hit` stops at the first one (shadow rays).
-fn trace(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
-    var hit = Hit(t_max, NO_HIT, 0.0, 0.0);
+// Closest hit with t < t_max in the BVH under `root`, starting from `best`; `any_hit` stops
+// at the first one (shadow rays). Hits are tagged with `instance`.
+fn trace_blas(ray: Ray, root: u32, best: Hit, any_hit: bool, instance: u32) -> Hit {
+    var hit = best;
     let inv_dir = 1.0 / ray.dir;
     var stack: array<u32, STACK_SIZE>;
     var sp = 0u;
-    var index = 0u;
-    if (intersect_node(load_node(0), ray.origin, inv_dir, hit.t) == INF) {
+    var index = root;
+    if (intersect_node(load_node(root), ray.origin, inv_dir, hit.t) == INF) {
         return hit;
     }
     loop {
@@ -65,10 +69,68 @@ fn trace(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
                 let tri = load_triangle(i);
                 let r = intersect_triangle(ray, tri);
                 if (r.x < hit.t && (!ALPHA_TEST || (tri.flags & TRI_ALPHA) == 0u || alpha_passes(i, r.y, r.z, ray))) {
-                    hit = Hit(r.x, i, r.y, r.z);
+                    hit = Hit(r.x, i, r.y, r.z, instance);
                     if (any_hit) {
                         return hit;
                     }
+                }
+            }
+        } else {
+            let left = node.index;
+            let right = node.index + 1u;
+            let t_left = intersect_node(load_node(left), ray.origin, inv_dir, hit.t);
+            let t_right = intersect_node(load_node(right), ray.origin, inv_dir, hit.t);
+            if (t_left != INF && t_right != INF) {
+                let near_is_left = t_left <= t_right;
+                if (sp < STACK_SIZE) {
+                    stack[sp] = select(left, right, near_is_left);
+                    sp += 1u;
+                }
+                index = select(right, left, near_is_left);
+                continue;
+            }
+            if (t_left != INF) {
+                index = left;
+                continue;
+            }
+            if (t_right != INF) {
+                index = right;
+                continue;
+            }
+        }
+        if (sp == 0u) {
+            break;
+        }
+        sp -= 1u;
+        index = stack[sp];
+    }
+    return hit;
+}
+
+// Closest (or any) hit with t < t_max. With instancing, node 0 is the top level over
+// instances; a leaf's instances are entered with the ray in object space (the direction is
+// not renormalised, so t stays the world distance parameter).
+fn trace(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
+    var hit = Hit(t_max, NO_HIT, 0.0, 0.0, 0u);
+    if (!INSTANCING) {
+        return trace_blas(ray, 0u, hit, any_hit, 0u);
+    }
+    let inv_dir = 1.0 / ray.dir;
+    var stack: array<u32, STACK_SIZE>;
+    var sp = 0u;
+    var index = 0u;
+    if (intersect_node(load_node(0u), ray.origin, inv_dir, hit.t) == INF) {
+        return hit;
+    }
+    loop {
+        let node = load_node(index);
+        if (node.count > 0u) {
+            for (var k = node.index; k < node.index + node.count; k++) {
+                let inst = load_instance(k);
+                let local = Ray(transform_point(inst.world_to_object, ray.origin), transform_dir(inst.world_to_object, ray.dir));
+                hit = trace_blas(local, inst.blas_root, hit, any_hit, k);
+                if (any_hit && hit.tri != NO_HIT) {
+                    return hit;
                 }
             }
         } else {

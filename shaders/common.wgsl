@@ -16,6 +16,7 @@ override ALPHA_TEST: bool = true;
 override TEXTURES: bool = true;
 override PUNCTUAL_LIGHTS: bool = true;
 override TRANSMISSION: bool = true;
+override INSTANCING: bool = true;
 
 struct BvhNode {
     min: vec3<f32>,
@@ -37,6 +38,8 @@ const TRI_HAS_NORMALS: u32 = 1u;
 const TRI_HAS_TANGENTS: u32 = 2u;
 const TRI_ALPHA: u32 = 4u;
 const TRI_TANGENT_SIGN_SHIFT: u32 = 3u;
+// Set on a triangle moved to world space by a mirroring instance: its winding is reversed.
+const TRI_MIRRORED: u32 = 64u;
 
 // Per-triangle vertex attributes: octahedral normals and tangents, TEXCOORD_0.
 struct Attributes {
@@ -139,6 +142,11 @@ struct Params {
     // Punctual lights: first row in the light-data buffer, and how many.
     punctual_base: u32,
     punctual_count: u32,
+    // First instance record in the node array (two-level BVH).
+    instance_base: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 struct Ray {

@@ -54,11 +54,12 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
             radiance += beta * environment_radiance(ray.dir) * w;
             break;
         }
-        let tri = load_triangle(hit.tri);
+        let tri = world_triangle(hit.tri, hit.instance);
         let uv = triangle_uv(hit.tri, hit.u, hit.v);
         let m = material_at(materials[tri.material], uv);
         let point = tri.p0 + hit.u * tri.e1 + hit.v * tri.e2;
-        let ng_raw = normalize(cross(tri.e1, tri.e2));
+        let ng_cross = normalize(cross(tri.e1, tri.e2));
+        let ng_raw = select(ng_cross, -ng_cross, (tri.flags & TRI_MIRRORED) != 0u);
         let cos_hit = dot(ray.dir, ng_raw);
         // Leaving a volume through its back face: Beer–Lambert over the segment inside.
         if (TRANSMISSION && cos_hit > 0.0 && max_component(m.attenuation) > 0.0) {
@@ -85,7 +86,7 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
         // relative index of refraction for light crossing from the ray's side.
         let ng = select(ng_raw, -ng_raw, cos_hit > 0.0);
         let eta = select(1.0 / m.ior, m.ior, cos_hit < 0.0);
-        var ns = shading_normal(tri, hit.tri, hit.u, hit.v, ng_raw, m, uv);
+        var ns = shading_normal(tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, m, uv);
         ns = select(ns, -ns, dot(ns, ray.dir) > 0.0);
         let frame = frame_from_normal(ns);
         let wo = to_local(frame, -ray.dir);

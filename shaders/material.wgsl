@@ -6,6 +6,7 @@
 #include "rng.wgsl"
 #include "frame.wgsl"
 #include "texture.wgsl"
+#include "instance.wgsl"
 
 // TEXCOORD_0 at barycentrics (u, v) of vertices 1 and 2.
 fn triangle_uv(index: u32, u: f32, v: f32) -> vec2<f32> {
@@ -61,18 +62,30 @@ fn oct_decode(bits: u32) -> vec3<f32> {
 
 // The front-facing shading normal at (u, v): interpolated vertex normals (else ng), then the
 // normal map: n' = T·x + B·y + N·z with T Gram-Schmidt'd against N and B = cross(N, T)·w.
-fn shading_normal(tri: Triangle, index: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec2<f32>) -> vec3<f32> {
+// Attributes are in object space: with instancing they move to world space here (normals by
+// the inverse transpose, tangents by the transform, handedness flipped by mirroring).
+fn shading_normal(tri: Triangle, index: u32, instance: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec2<f32>) -> vec3<f32> {
     var n = ng;
     let a = load_attributes(index);
+    var inst: Instance;
+    if (INSTANCING) {
+        inst = load_instance(instance);
+    }
     if ((tri.flags & TRI_HAS_NORMALS) != 0u) {
-        let s = (1.0 - u - v) * oct_decode(a.n.x) + u * oct_decode(a.n.y) + v * oct_decode(a.n.z);
+        var s = (1.0 - u - v) * oct_decode(a.n.x) + u * oct_decode(a.n.y) + v * oct_decode(a.n.z);
+        if (INSTANCING) {
+            s = transform_normal(inst.world_to_object, s);
+        }
         let len2 = dot(s, s);
         n = select(ng, s * inverseSqrt(len2), len2 > 0.0);
     }
     if (!TEXTURES || (tri.flags & TRI_HAS_TANGENTS) == 0u || m.normal_texture.layer == NO_TEXTURE) {
         return n;
     }
-    let t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12.x) + v * oct_decode(a.t12.y);
+    var t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12.x) + v * oct_decode(a.t12.y);
+    if (INSTANCING) {
+        t_interp = transform_dir(inst.object_to_world, t_interp);
+    }
     let t_ortho = t_interp - n * dot(n, t_interp);
     let len2 = dot(t_ortho, t_ortho);
     if (len2 <= 1e-12) {
@@ -80,7 +93,10 @@ fn shading_normal(tri: Triangle, index: u32, u: f32, v: f32, ng: vec3<f32>, m: M
     }
     let t = t_ortho * inverseSqrt(len2);
     // The handedness of the vertex nearest to the point (all three agree within an island).
-    let w = select(1.0, -1.0, ((tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1u) != 0u);
+    var w = select(1.0, -1.0, ((tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1u) != 0u);
+    if ((tri.flags & TRI_MIRRORED) != 0u) {
+        w = -w;
+    }
     let b = cross(n, t) * w;
     let c = sample_texture(m.normal_texture, uv).xyz * 2.0 - 1.0;
     let mapped = t * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + n * c.z;

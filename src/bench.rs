@@ -157,7 +157,7 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<Ra
         .zip(&hits)
         .filter(|(_, hit)| hit.tri != crate::cpu::bvh::NO_HIT)
         .map(|(ray, hit)| {
-            let tri = &scene.triangles[hit.tri as usize];
+            let tri = crate::cpu::instance::world_triangle(scene, hit.tri, hit.instance);
             let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
             let n = e1.cross(e2).normalize();
             let n = if n.dot(ray.dir) > 0.0 { -n } else { n };

@@ -42,6 +42,8 @@ pub const TRI_HAS_TANGENTS: u32 = 2;
 pub const TRI_ALPHA: u32 = 4;
 /// Bits 3, 4, 5: vertex 0, 1, 2's tangent has handedness −1.
 pub const TRI_TANGENT_SIGN_SHIFT: u32 = 3;
+/// Set on a triangle moved to world space by a mirroring instance (winding reversed).
+pub const TRI_MIRRORED: u32 = 64;
 
 /// Per-triangle vertex attributes: octahedron-encoded normals and tangents
 /// (`pack2x16snorm`) and TEXCOORD_0, one of each per vertex.
@@ -140,7 +142,13 @@ pub struct LightEntry {
 
 #[derive(Clone)]
 pub struct PackedScene {
+    /// BVH nodes. With instances: the top-level BVH over instances from node 0, then the
+    /// world mesh's and each stored mesh's BVH, then the instance records (four node-sized
+    /// slots each, from `instance_base`).
     pub nodes: Vec<BvhNode>,
+    pub instance_base: u32,
+    /// Instance records, the world mesh's (identity) included; 0 without instancing.
+    pub instance_count: u32,
     pub triangles: Vec<PackedTriangle>,
     pub attributes: Vec<PackedAttributes>,
     pub materials: Vec<PackedMaterial>,
@@ -195,61 +203,22 @@ impl PackedScene {
             light_pdf[l.triangle as usize] = l.pmf / area;
         }
 
-        let triangles = ordered
-            .iter()
-            .zip(&light_pdf)
-            .map(|(t, &pdf)| {
-                let [p0, p1, p2] = t.positions;
-                let ng = t.cross().normalize_or_zero();
-                let m = &scene.materials[t.material as usize];
-                let mut flags = 0;
-                if !t.normals.iter().all(|n| n.dot(ng) > 0.99999) {
-                    flags |= TRI_HAS_NORMALS;
-                }
-                if t.tangents.iter().all(|v| v.truncate() != Vec3::ZERO) {
-                    flags |= TRI_HAS_TANGENTS;
-                    for (k, v) in t.tangents.iter().enumerate() {
-                        if v.w < 0.0 {
-                            flags |= 1 << (TRI_TANGENT_SIGN_SHIFT + k as u32);
-                        }
-                    }
-                }
-                let cutout = match m.alpha_mode {
-                    AlphaMode::Opaque => false,
-                    AlphaMode::Mask(_) => true,
-                    AlphaMode::Blend => m.alpha < 1.0 || m.base_color_texture.is_some(),
-                };
-                if cutout {
-                    flags |= TRI_ALPHA;
-                }
-                PackedTriangle {
-                    p0: p0.into(),
-                    material: t.material,
-                    e1: (p1 - p0).into(),
-                    light_pdf_area: pdf,
-                    e2: (p2 - p0).into(),
-                    flags,
-                }
-            })
-            .collect();
-        let mut triangles: Vec<PackedTriangle> = triangles;
+        let mut triangles: Vec<PackedTriangle> =
+            ordered.iter().zip(&light_pdf).map(|(t, &pdf)| pack_triangle(scene, t, pdf)).collect();
         if triangles.is_empty() {
             // The empty BVH's leaf points at one zero-area triangle that no ray hits.
             triangles.push(PackedTriangle::zeroed());
         }
-        let mut attributes: Vec<PackedAttributes> = ordered
-            .iter()
-            .map(|t| {
-                let tan = t.tangents.map(|v| oct_encode(v.truncate()));
-                PackedAttributes {
-                    n: t.normals.map(oct_encode),
-                    t0: tan[0],
-                    t12: [tan[1], tan[2]],
-                    uv: t.uvs.map(|v| v.into()),
-                }
-            })
-            .collect();
+        let mut attributes: Vec<PackedAttributes> = ordered.iter().map(|t| pack_attributes(t)).collect();
         attributes.resize(triangles.len(), PackedAttributes::zeroed());
+        let mut nodes = bvh.nodes;
+        let mut build_seconds = bvh.build_seconds;
+        let mut instance_base = 0;
+        if !scene.instances.is_empty() {
+            (nodes, instance_base, build_seconds) =
+                build_instances(scene, nodes, &mut triangles, &mut attributes, build_seconds);
+        }
+        let nodes_len = nodes.len();
         let (mut env, env_width, env_height, env_total) = match &scene.environment_map {
             Some(map) => pack_environment(map),
             None => (vec![[0.0; 4]], 0, 0, 0.0),
@@ -277,13 +246,19 @@ impl PackedScene {
         let bounds = scene.bounds();
         let extent = if bounds.is_empty() { 1.0 } else { bounds.diagonal().length() };
         PackedScene {
-            nodes: bvh.nodes,
+            nodes,
+            instance_base,
+            instance_count: if scene.instances.is_empty() {
+                0
+            } else {
+                (nodes_len - instance_base as usize) as u32 / 4
+            },
             triangles,
             attributes,
             materials,
             lights,
             order: bvh.order,
-            bvh_build_seconds: bvh.build_seconds,
+            bvh_build_seconds: build_seconds,
             environment: scene.environment,
             env,
             punctual_base,
@@ -306,17 +281,19 @@ pub struct Features {
     pub textures: bool,
     pub punctual_lights: bool,
     pub transmission: bool,
+    pub instancing: bool,
 }
 
 impl Features {
     /// The pipeline constants of `shaders/common.wgsl`.
-    pub fn constants(&self) -> [(&'static str, f64); 4] {
+    pub fn constants(&self) -> [(&'static str, f64); 5] {
         let f = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("ALPHA_TEST", f(self.alpha_test)),
             ("TEXTURES", f(self.textures)),
             ("PUNCTUAL_LIGHTS", f(self.punctual_lights)),
             ("TRANSMISSION", f(self.transmission)),
+            ("INSTANCING", f(self.instancing)),
         ]
     }
 }
@@ -333,8 +310,190 @@ impl PackedScene {
             textures: self.materials.iter().any(textured),
             punctual_lights: self.punctual_count > 0,
             transmission: self.materials.iter().any(|m| m.transmission > 0.0 || m.attenuation != [0.0; 3]),
+            instancing: self.instance_count > 0,
         }
     }
+}
+
+fn pack_triangle(scene: &Scene, t: &crate::scene::Triangle, light_pdf_area: f32) -> PackedTriangle {
+    let [p0, p1, p2] = t.positions;
+    let ng = t.cross().normalize_or_zero();
+    let m = &scene.materials[t.material as usize];
+    let mut flags = 0;
+    if !t.normals.iter().all(|n| n.dot(ng) > 0.99999) {
+        flags |= TRI_HAS_NORMALS;
+    }
+    if t.tangents.iter().all(|v| v.truncate() != Vec3::ZERO) {
+        flags |= TRI_HAS_TANGENTS;
+        for (k, v) in t.tangents.iter().enumerate() {
+            if v.w < 0.0 {
+                flags |= 1 << (TRI_TANGENT_SIGN_SHIFT + k as u32);
+            }
+        }
+    }
+    let cutout = match m.alpha_mode {
+        AlphaMode::Opaque => false,
+        AlphaMode::Mask(_) => true,
+        AlphaMode::Blend => m.alpha < 1.0 || m.base_color_texture.is_some(),
+    };
+    if cutout {
+        flags |= TRI_ALPHA;
+    }
+    PackedTriangle {
+        p0: p0.into(),
+        material: t.material,
+        e1: (p1 - p0).into(),
+        light_pdf_area,
+        e2: (p2 - p0).into(),
+        flags,
+    }
+}
+
+fn pack_attributes(t: &crate::scene::Triangle) -> PackedAttributes {
+    let tan = t.tangents.map(|v| oct_encode(v.truncate()));
+    PackedAttributes { n: t.normals.map(oct_encode), t0: tan[0], t12: [tan[1], tan[2]], uv: t.uvs.map(|v| v.into()) }
+}
+
+/// An instance as the kernel reads it: object→world and world→object as 3×4 rows, the root
+/// of its mesh's BVH and whether it mirrors; four BvhNode-sized slots.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct PackedInstance {
+    pub object_to_world: [[f32; 4]; 3],
+    pub world_to_object: [[f32; 4]; 3],
+    pub blas_root: u32,
+    /// INSTANCE_MIRRORED when the transform flips handedness.
+    pub flags: u32,
+    pub pad: [u32; 6],
+}
+
+pub const INSTANCE_MIRRORED: u32 = 1;
+
+fn rows(m: glam::Mat4) -> [[f32; 4]; 3] {
+    let r = m.transpose().to_cols_array_2d();
+    [r[0], r[1], r[2]]
+}
+
+/// Two-level BVH: each stored mesh's BVH (object space) after the world mesh's, the instance
+/// records after them, and a top-level BVH over instance bounds at node 0. Returns the nodes,
+/// the first instance slot and the build time.
+fn build_instances(
+    scene: &Scene,
+    world_nodes: Vec<BvhNode>,
+    triangles: &mut Vec<PackedTriangle>,
+    attributes: &mut Vec<PackedAttributes>,
+    mut seconds: f64,
+) -> (Vec<BvhNode>, u32, f64) {
+    // Items: the world mesh (identity) when it has triangles, then every instance.
+    struct Item {
+        blas_root: u32,
+        transform: glam::Mat4,
+        bounds: crate::scene::Bounds,
+    }
+    let mut blas_nodes: Vec<BvhNode> = Vec::new();
+    let mut items = Vec::new();
+    let world_bounds = {
+        let mut b = crate::scene::Bounds::empty();
+        scene.triangles.iter().flat_map(|t| t.positions).for_each(|p| b.grow(p));
+        b
+    };
+    // Node indices are fixed up once the top level's size is known: BLAS roots are relative
+    // to the start of the BLAS block for now.
+    let append_blas = |nodes: &[BvhNode], tri_offset: u32, blas_nodes: &mut Vec<BvhNode>| -> u32 {
+        let base = blas_nodes.len() as u32;
+        blas_nodes.extend(nodes.iter().map(|n| {
+            let mut n = *n;
+            if n.count > 0 {
+                n.index += tri_offset;
+            } else {
+                n.index += base;
+            }
+            n
+        }));
+        base
+    };
+    if !scene.triangles.is_empty() {
+        let root = append_blas(&world_nodes, 0, &mut blas_nodes);
+        items.push(Item { blas_root: root, transform: glam::Mat4::IDENTITY, bounds: world_bounds });
+    }
+    let mut mesh_roots = Vec::new();
+    for mesh in &scene.meshes {
+        let verts: Vec<[Vec3; 3]> = mesh.triangles.iter().map(|t| t.positions).collect();
+        let bvh = accel::build(&verts);
+        seconds += bvh.build_seconds;
+        let tri_offset = triangles.len() as u32;
+        if mesh.triangles.is_empty() {
+            triangles.push(PackedTriangle::zeroed());
+            attributes.push(PackedAttributes::zeroed());
+        }
+        for &i in &bvh.order {
+            let t = &mesh.triangles[i as usize];
+            triangles.push(pack_triangle(scene, t, 0.0));
+            attributes.push(pack_attributes(t));
+        }
+        mesh_roots.push(append_blas(&bvh.nodes, tri_offset, &mut blas_nodes));
+    }
+    for inst in &scene.instances {
+        items.push(Item {
+            blas_root: mesh_roots[inst.mesh as usize],
+            transform: inst.transform,
+            bounds: scene.instance_bounds(inst),
+        });
+    }
+    // Top level: median splits over item centroids, children allocated in pairs.
+    let mut order: Vec<usize> = (0..items.len()).collect();
+    let mut tlas = vec![BvhNode::zeroed()];
+    let bounds_of = |ids: &[usize]| {
+        let mut b = crate::scene::Bounds::empty();
+        for &i in ids {
+            if !items[i].bounds.is_empty() {
+                b.grow(items[i].bounds.min);
+                b.grow(items[i].bounds.max);
+            }
+        }
+        if b.is_empty() { crate::scene::Bounds { min: Vec3::ZERO, max: Vec3::ZERO } } else { b }
+    };
+    let mut work = vec![(0usize, 0usize, order.len())];
+    while let Some((node, lo, hi)) = work.pop() {
+        let b = bounds_of(&order[lo..hi]);
+        if hi - lo <= 2 {
+            tlas[node] = BvhNode { min: b.min.into(), index: lo as u32, max: b.max.into(), count: (hi - lo) as u32 };
+            continue;
+        }
+        let axis = b.diagonal().max_position();
+        order[lo..hi].sort_by(|&x, &y| {
+            let c = |i: usize| items[i].bounds.center()[axis];
+            c(x).total_cmp(&c(y))
+        });
+        let mid = (lo + hi) / 2;
+        let left = tlas.len();
+        tlas.push(BvhNode::zeroed());
+        tlas.push(BvhNode::zeroed());
+        tlas[node] = BvhNode { min: b.min.into(), index: left as u32, max: b.max.into(), count: 0 };
+        work.push((left, lo, mid));
+        work.push((left + 1, mid, hi));
+    }
+    let blas_base = tlas.len() as u32;
+    for n in &mut blas_nodes {
+        if n.count == 0 {
+            n.index += blas_base;
+        }
+    }
+    let mut nodes = tlas;
+    nodes.extend(blas_nodes);
+    let instance_base = nodes.len() as u32;
+    for &i in &order {
+        let it = &items[i];
+        let record = PackedInstance {
+            object_to_world: rows(it.transform),
+            world_to_object: rows(it.transform.inverse()),
+            blas_root: it.blas_root + blas_base,
+            flags: if glam::Mat3::from_mat4(it.transform).determinant() < 0.0 { INSTANCE_MIRRORED } else { 0 },
+            pad: [0; 6],
+        };
+        nodes.extend_from_slice(bytemuck::cast_slice::<PackedInstance, BvhNode>(&[record]));
+    }
+    (nodes, instance_base, seconds)
 }
 
 /// The environment's texels with the CDFs of the piecewise-constant distribution

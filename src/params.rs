@@ -41,6 +41,9 @@ pub struct Params {
     /// Punctual lights: first row in `PackedScene::env`, and how many.
     pub punctual_base: u32,
     pub punctual_count: u32,
+    /// First instance record in the node array (when the scene has instances).
+    pub instance_base: u32,
+    pub pad: [u32; 3],
 }
 
 /// Russian roulette starts once a path has this many segments.
@@ -101,6 +104,8 @@ impl Params {
             row_offset: 0,
             punctual_base: scene.punctual_base,
             punctual_count: scene.punctual_count,
+            instance_base: scene.instance_base,
+            pad: [0; 3],
         }
     }
 }

@@ -172,7 +172,7 @@ fn info_describes_a_scene() {
     let out = String::from_utf8_lossy(&r.stdout);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     for needle in [
-        "triangles 32 (2 emissive)",
+        "triangles 32 (32 stored, 2 emissive)",
         "meshes 8",
         "instances (nodes with a mesh) 8",
         "materials 4",

@@ -1,5 +1,6 @@
 //! Twin of `shaders/bvh.wgsl`: the same traversal over the same nodes.
 
+use super::instance::{load_instance, transform_dir, transform_point};
 use super::material::alpha_passes;
 use crate::packed::{BvhNode, PackedScene, PackedTriangle, TRI_ALPHA};
 use glam::{IVec3, Vec3};
@@ -20,6 +21,7 @@ pub struct Hit {
     pub tri: u32,
     pub u: f32,
     pub v: f32,
+    pub instance: u32,
 }
 
 pub fn intersect_triangle(ray: &Ray, tri: &PackedTriangle) -> Vec3 {
@@ -54,9 +56,66 @@ pub fn intersect_node(node: &BvhNode, origin: Vec3, inv_dir: Vec3, t_max: f32) -
     if t_enter <= t_exit { t_enter } else { INF }
 }
 
-pub fn trace(scene: &PackedScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
+pub fn trace_blas(scene: &PackedScene, ray: &Ray, root: u32, best: Hit, any_hit: bool, instance: u32) -> Hit {
     let (nodes, triangles): (&[BvhNode], &[PackedTriangle]) = (&scene.nodes, &scene.triangles);
-    let mut hit = Hit { t: t_max, tri: NO_HIT, u: 0.0, v: 0.0 };
+    let mut hit = best;
+    let inv_dir = Vec3::ONE / ray.dir;
+    let mut stack = [0u32; STACK_SIZE];
+    let mut sp = 0usize;
+    let mut index = root as usize;
+    if intersect_node(&nodes[index], ray.origin, inv_dir, hit.t) == INF {
+        return hit;
+    }
+    loop {
+        let node = &nodes[index];
+        if node.count > 0 {
+            for i in node.index..node.index + node.count {
+                let tri = &triangles[i as usize];
+                let r = intersect_triangle(ray, tri);
+                if r.x < hit.t && (tri.flags & TRI_ALPHA == 0 || alpha_passes(scene, i, r.y, r.z, ray)) {
+                    hit = Hit { t: r.x, tri: i, u: r.y, v: r.z, instance };
+                    if any_hit {
+                        return hit;
+                    }
+                }
+            }
+        } else {
+            let (left, right) = (node.index as usize, node.index as usize + 1);
+            let t_left = intersect_node(&nodes[left], ray.origin, inv_dir, hit.t);
+            let t_right = intersect_node(&nodes[right], ray.origin, inv_dir, hit.t);
+            if t_left != INF && t_right != INF {
+                let near_is_left = t_left <= t_right;
+                if sp < STACK_SIZE {
+                    stack[sp] = if near_is_left { right } else { left } as u32;
+                    sp += 1;
+                }
+                index = if near_is_left { left } else { right };
+                continue;
+            }
+            if t_left != INF {
+                index = left;
+                continue;
+            }
+            if t_right != INF {
+                index = right;
+                continue;
+            }
+        }
+        if sp == 0 {
+            break;
+        }
+        sp -= 1;
+        index = stack[sp] as usize;
+    }
+    hit
+}
+
+pub fn trace(scene: &PackedScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
+    let mut hit = Hit { t: t_max, tri: NO_HIT, u: 0.0, v: 0.0, instance: 0 };
+    if scene.instance_count == 0 {
+        return trace_blas(scene, ray, 0, hit, any_hit, 0);
+    }
+    let nodes = &scene.nodes[..];
     let inv_dir = Vec3::ONE / ray.dir;
     let mut stack = [0u32; STACK_SIZE];
     let mut sp = 0usize;
@@ -67,14 +126,15 @@ pub fn trace(scene: &PackedScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
     loop {
         let node = &nodes[index];
         if node.count > 0 {
-            for i in node.index..node.index + node.count {
-                let tri = &triangles[i as usize];
-                let r = intersect_triangle(ray, tri);
-                if r.x < hit.t && (tri.flags & TRI_ALPHA == 0 || alpha_passes(scene, i, r.y, r.z, ray)) {
-                    hit = Hit { t: r.x, tri: i, u: r.y, v: r.z };
-                    if any_hit {
-                        return hit;
-                    }
+            for k in node.index..node.index + node.count {
+                let inst = load_instance(scene, k);
+                let local = Ray {
+                    origin: transform_point(&inst.world_to_object, ray.origin),
+                    dir: transform_dir(&inst.world_to_object, ray.dir),
+                };
+                hit = trace_blas(scene, &local, inst.blas_root, hit, any_hit, k);
+                if any_hit && hit.tri != NO_HIT {
+                    return hit;
                 }
             }
         } else {

@@ -5,12 +5,13 @@ use super::bvh::{INF, NO_HIT, Ray, intersect_closest, occluded, offset_ray};
 use super::camera::generate_ray;
 use super::environment::{environment_pdf, environment_radiance};
 use super::frame::{frame_from_normal, from_local, to_local};
+use super::instance::world_triangle;
 use super::lights::{LightSample, light_pdf, sample_light, sample_punctual};
 use super::material::{material_at, shading_normal, triangle_uv};
 use super::mis::mis_weight;
 use super::rng::{rng_init, rng_next, rng_next2};
 use crate::Strategy;
-use crate::packed::PackedScene;
+use crate::packed::{PackedScene, TRI_MIRRORED};
 use crate::params::Params;
 use glam::{UVec2, Vec3};
 
@@ -32,7 +33,6 @@ fn unoccluded(scene: &PackedScene, origin: Vec3, ls: &LightSample) -> bool {
 
 pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) -> Vec3 {
     let strategy = Strategy::from_u32(params.strategy);
-    let tris = &scene.triangles[..];
     let mut radiance = Vec3::ZERO;
     let mut beta = Vec3::ONE;
     let mut ray = camera_ray;
@@ -54,12 +54,13 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
             radiance += beta * environment_radiance(scene, params, ray.dir) * w;
             break;
         }
-        let tri = &tris[hit.tri as usize];
+        let tri = &world_triangle(scene, hit.tri, hit.instance);
         let uv = triangle_uv(scene, hit.tri, hit.u, hit.v);
         let m = &material_at(scene, &scene.materials[tri.material as usize], uv);
         let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
         let point = Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2;
-        let ng_raw = e1.cross(e2).normalize();
+        let ng_cross = e1.cross(e2).normalize();
+        let ng_raw = if tri.flags & TRI_MIRRORED != 0 { -ng_cross } else { ng_cross };
         let cos_hit = ray.dir.dot(ng_raw);
         let attenuation = Vec3::from(m.attenuation);
         if cos_hit > 0.0 && attenuation.max_element() > 0.0 {
@@ -84,7 +85,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
 
         let ng = if cos_hit > 0.0 { -ng_raw } else { ng_raw };
         let eta = if cos_hit < 0.0 { m.ior } else { 1.0 / m.ior };
-        let mut ns = shading_normal(scene, tri, hit.tri, hit.u, hit.v, ng_raw, m, uv);
+        let mut ns = shading_normal(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, m, uv);
         if ns.dot(ray.dir) > 0.0 {
             ns = -ns;
         }

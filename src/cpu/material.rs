@@ -1,11 +1,12 @@
 //! Twin of `shaders/material.wgsl`: textured material, alpha and the normal-mapped shading normal.
 
 use super::bvh::Ray;
+use super::instance::{load_instance, transform_dir, transform_normal};
 use super::rng::pcg_hash;
 use super::texture::sample_texture;
 use crate::packed::{
     MAT_ALPHA_MASK, NO_TEXTURE, PackedMaterial, PackedScene, PackedTriangle, TRI_HAS_NORMALS, TRI_HAS_TANGENTS,
-    TRI_TANGENT_SIGN_SHIFT, oct_decode,
+    TRI_MIRRORED, TRI_TANGENT_SIGN_SHIFT, oct_decode,
 };
 use glam::{Vec2, Vec3};
 
@@ -60,6 +61,7 @@ pub fn shading_normal(
     scene: &PackedScene,
     tri: &PackedTriangle,
     index: u32,
+    instance: u32,
     u: f32,
     v: f32,
     ng: Vec3,
@@ -68,22 +70,32 @@ pub fn shading_normal(
 ) -> Vec3 {
     let mut n = ng;
     let a = &scene.attributes[index as usize];
+    let inst = (scene.instance_count > 0).then(|| load_instance(scene, instance));
     if tri.flags & TRI_HAS_NORMALS != 0 {
-        let s = (1.0 - u - v) * oct_decode(a.n[0]) + u * oct_decode(a.n[1]) + v * oct_decode(a.n[2]);
+        let mut s = (1.0 - u - v) * oct_decode(a.n[0]) + u * oct_decode(a.n[1]) + v * oct_decode(a.n[2]);
+        if let Some(inst) = &inst {
+            s = transform_normal(&inst.world_to_object, s);
+        }
         let len2 = s.dot(s);
         n = if len2 > 0.0 { s / len2.sqrt() } else { ng };
     }
     if tri.flags & TRI_HAS_TANGENTS == 0 || m.normal_texture.layer == NO_TEXTURE {
         return n;
     }
-    let t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12[0]) + v * oct_decode(a.t12[1]);
+    let mut t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12[0]) + v * oct_decode(a.t12[1]);
+    if let Some(inst) = &inst {
+        t_interp = transform_dir(&inst.object_to_world, t_interp);
+    }
     let t_ortho = t_interp - n * n.dot(t_interp);
     let len2 = t_ortho.dot(t_ortho);
     if len2 <= 1e-12 {
         return n;
     }
     let t = t_ortho / len2.sqrt();
-    let w = if (tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1 != 0 { -1.0 } else { 1.0 };
+    let mut w = if (tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1 != 0 { -1.0 } else { 1.0 };
+    if tri.flags & TRI_MIRRORED != 0 {
+        w = -w;
+    }
     let b = n.cross(t) * w;
     let c = sample_texture(scene, &m.normal_texture, uv).truncate() * 2.0 - Vec3::ONE;
     let mapped = t * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + n * c.z;

@@ -8,6 +8,7 @@ pub mod bvh;
 pub mod camera;
 pub mod environment;
 pub mod frame;
+pub mod instance;
 pub mod integrator;
 pub mod lights;
 pub mod material;

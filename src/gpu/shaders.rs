@@ -12,6 +12,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("geometry_buffers.wgsl", include_str!("../../shaders/geometry_buffers.wgsl")),
     ("geometry_textures.wgsl", include_str!("../../shaders/geometry_textures.wgsl")),
     ("texture.wgsl", include_str!("../../shaders/texture.wgsl")),
+    ("instance.wgsl", include_str!("../../shaders/instance.wgsl")),
     ("material.wgsl", include_str!("../../shaders/material.wgsl")),
     ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
     ("camera.wgsl", include_str!("../../shaders/camera.wgsl")),

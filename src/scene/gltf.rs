@@ -125,13 +125,16 @@ pub fn describe_file(path: &Path) -> Result<String, Error> {
     let bounds = if b.is_empty() { "empty".to_string() } else { format!("{} .. {}", b.min, b.max) };
     let cameras: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
     Ok(format!(
-        "{}\n  triangles {} ({} emissive)\n  meshes {}\n  instances (nodes with a mesh) {}\n  materials {}\n  textures {} (images {})\n  \
+        "{}\n  triangles {} ({} stored, {} emissive)\n  meshes {}\n  instances (nodes with a mesh) {} ({} drawing {} meshes stored once)\n  materials {}\n  textures {} (images {})\n  \
          punctual lights {}\n  cameras {} ({})\n  extensions used: {}\n  extensions required: {}\n  bounds {}",
         path.display(),
-        scene.triangles.len(),
+        scene.drawn_triangle_count(),
+        scene.triangles.len() + scene.meshes.iter().map(|m| m.triangles.len()).sum::<usize>(),
         scene.emissive_triangle_count(),
         count("meshes"),
         instances,
+        scene.instances.len(),
+        scene.meshes.len(),
         count("materials"),
         count("textures"),
         count("images"),
@@ -235,6 +238,26 @@ fn from_document(
         scene.environment = env;
     }
 
+    // Meshes drawn by several nodes are stored once and instanced, unless they emit (lights
+    // are sampled per world-space triangle) or a transform cannot be inverted.
+    let mut uses = vec![0usize; doc.meshes().len()];
+    {
+        let mut stack: Vec<(gltf::Node, usize)> = gltf_scene.nodes().map(|n| (n, 0)).collect();
+        let mut visits = 0usize;
+        while let Some((node, depth)) = stack.pop() {
+            visits += 1;
+            if visits > MAX_NODE_VISITS || depth > 256 {
+                break; // reported by the main walk below
+            }
+            if let Some(m) = node.mesh()
+                && let Some(u) = uses.get_mut(m.index())
+            {
+                *u += 1;
+            }
+            stack.extend(node.children().map(|c| (c, depth + 1)));
+        }
+    }
+    let mut stored: Vec<Option<u32>> = vec![None; uses.len()];
     let mut stack: Vec<(gltf::Node, Mat4, usize)> = gltf_scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     let mut visits = 0usize;
     while let Some((node, parent, depth)) = stack.pop() {
@@ -261,7 +284,31 @@ fn from_document(
             scene.cameras.push(Camera::from_matrix(name, world, p.yfov()));
         }
         if let Some(mesh) = node.mesh() {
-            load_mesh(&mesh, world, buffers, default_material, &mut scene)?;
+            let emits = mesh.primitives().any(|p| {
+                let m = p.material().index().map_or(default_material as usize, |i| i);
+                scene.materials.get(m).is_some_and(Material::is_emissive)
+            });
+            let det = Mat3::from_mat4(world).determinant();
+            let invertible = det.is_finite() && det.abs() > 1e-24 && world.inverse().is_finite();
+            if uses.get(mesh.index()).is_some_and(|&u| u >= 2) && !emits && invertible {
+                let id = match stored[mesh.index()] {
+                    Some(id) => id,
+                    None => {
+                        let world_triangles = std::mem::take(&mut scene.triangles);
+                        let loaded = load_mesh(&mesh, Mat4::IDENTITY, buffers, default_material, &mut scene);
+                        let object = std::mem::replace(&mut scene.triangles, world_triangles);
+                        loaded?;
+                        let name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
+                        scene.meshes.push(super::Mesh { name, triangles: object });
+                        let id = scene.meshes.len() as u32 - 1;
+                        stored[mesh.index()] = Some(id);
+                        id
+                    }
+                };
+                scene.instances.push(super::Instance { mesh: id, transform: world });
+            } else {
+                load_mesh(&mesh, world, buffers, default_material, &mut scene)?;
+            }
         }
         if let Some(light) = node.light() {
             scene.punctual_lights.extend(convert_light(&light, world));

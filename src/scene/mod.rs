@@ -10,7 +10,7 @@ pub mod tangents;
 
 pub use camera::Camera;
 pub use environment::EnvironmentMap;
-use glam::{Vec2, Vec3, Vec4};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 
 /// One world-space triangle. Counter-clockwise winding is the front face.
 #[derive(Clone, Copy, Debug, Default)]
@@ -190,9 +190,27 @@ impl Bounds {
     }
 }
 
+/// A mesh stored once in object space and drawn by several nodes (instancing).
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub name: String,
+    pub triangles: Vec<Triangle>,
+}
+
+/// One placement of a `Mesh`: object-to-world transform (invertible).
+#[derive(Clone, Copy, Debug)]
+pub struct Instance {
+    pub mesh: u32,
+    pub transform: Mat4,
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Scene {
+    /// World-space triangles: every mesh drawn once, and every emitter.
     pub triangles: Vec<Triangle>,
+    /// Meshes drawn by several nodes, stored once (object space), and their placements.
+    pub meshes: Vec<Mesh>,
+    pub instances: Vec<Instance>,
     pub materials: Vec<Material>,
     pub cameras: Vec<Camera>,
     /// Environment radiance seen by rays that leave the scene: a constant color, or the
@@ -213,7 +231,43 @@ impl Scene {
                 b.grow(p);
             }
         }
+        for inst in &self.instances {
+            let ib = self.instance_bounds(inst);
+            if !ib.is_empty() {
+                b.grow(ib.min);
+                b.grow(ib.max);
+            }
+        }
         b
+    }
+
+    /// World-space bounds of an instance (its mesh's box, transformed).
+    pub fn instance_bounds(&self, inst: &Instance) -> Bounds {
+        let mut local = Bounds::empty();
+        for t in &self.meshes[inst.mesh as usize].triangles {
+            for p in t.positions {
+                local.grow(p);
+            }
+        }
+        let mut b = Bounds::empty();
+        if local.is_empty() {
+            return b;
+        }
+        for k in 0..8 {
+            let c = Vec3::new(
+                if k & 1 == 0 { local.min.x } else { local.max.x },
+                if k & 2 == 0 { local.min.y } else { local.max.y },
+                if k & 4 == 0 { local.min.z } else { local.max.z },
+            );
+            b.grow(inst.transform.transform_point3(c));
+        }
+        b
+    }
+
+    /// Triangles drawn, instanced ones counted once per instance.
+    pub fn drawn_triangle_count(&self) -> usize {
+        self.triangles.len()
+            + self.instances.iter().map(|i| self.meshes[i.mesh as usize].triangles.len()).sum::<usize>()
     }
 
     /// The named camera, the first one, or a default framing of the bounds.
