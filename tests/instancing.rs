@@ -95,7 +95,7 @@ fn placements() -> Vec<serde_json::Value> {
     ]
 }
 
-fn render(path: &PathBuf, backend: Backend, ctx: Option<veach::gpu::GpuContext>) -> veach::film::Film {
+fn render(path: &std::path::Path, backend: Backend, ctx: Option<veach::gpu::GpuContext>) -> veach::film::Film {
     let (scene, camera) = veach::load(path, None).unwrap();
     let settings = Settings { width: 48, height: 48, max_depth: 8, ..Settings::default() };
     let mut r = Renderer::with_gpu(PackedScene::new(&scene), &camera, &settings, backend, ctx).unwrap();
