@@ -21,6 +21,21 @@ fn spawn_point(point: vec3<f32>, ng: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     return offset_ray(point, select(-ng, ng, dot(wi, ng) > 0.0));
 }
 
+// f · |cos θ| · L for a light sample seen from the shading point, or 0 when the sample has no
+// density, the BSDF is zero, the two normals disagree on its side, or something blocks it
+// (tested last: it is the expensive part).
+fn connect(m: Material, frame: Frame, wo: vec3<f32>, eta: f32, point: vec3<f32>, ng: vec3<f32>, ls: LightSample) -> vec3<f32> {
+    if (ls.pdf <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let wi_local = to_local(frame, ls.wi);
+    let f = bsdf_eval(m, wo, wi_local, eta);
+    if (!same_side(ls.wi, ng, wi_local) || max_component(f) <= 0.0 || !unoccluded(spawn_point(point, ng, ls.wi), ls)) {
+        return vec3<f32>(0.0);
+    }
+    return f * abs(wi_local.z) * ls.radiance;
+}
+
 // Is the light sample visible from `origin`? Segments end just off the light's surface.
 fn unoccluded(origin: vec3<f32>, ls: LightSample) -> bool {
     if (ls.dist == INF) {
@@ -95,28 +110,19 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
         if (strategy != STRATEGY_BSDF && (params.light_count > 0u || params.env_select > 0.0)) {
             let u_light = vec3<f32>(rng_next(rng), rng_next2(rng));
             let ls = sample_light(point, u_light);
-            if (ls.pdf > 0.0) {
-                let wi_local = to_local(frame, ls.wi);
-                let f = bsdf_eval(m, wo, wi_local, eta);
-                if (same_side(ls.wi, ng, wi_local) && max_component(f) > 0.0 && unoccluded(spawn_point(point, ng, ls.wi), ls)) {
-                    var w = 1.0;
-                    if (strategy != STRATEGY_LIGHT) {
-                        w = mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, wi_local, eta));
-                    }
-                    radiance += beta * f * abs(wi_local.z) * ls.radiance * (w / ls.pdf);
+            let c = connect(m, frame, wo, eta, point, ng, ls);
+            if (max_component(c) > 0.0) {
+                var w = 1.0;
+                if (strategy != STRATEGY_LIGHT) {
+                    w = mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, to_local(frame, ls.wi), eta));
                 }
+                radiance += beta * c * (w / ls.pdf);
             }
         }
         // Punctual lights: only next-event estimation can reach them, whatever the strategy.
         if (PUNCTUAL_LIGHTS && params.punctual_count > 0u) {
             let ls = sample_punctual(point, rng_next(rng));
-            if (ls.pdf > 0.0) {
-                let wi_local = to_local(frame, ls.wi);
-                let f = bsdf_eval(m, wo, wi_local, eta);
-                if (same_side(ls.wi, ng, wi_local) && max_component(f) > 0.0 && unoccluded(spawn_point(point, ng, ls.wi), ls)) {
-                    radiance += beta * f * abs(wi_local.z) * ls.radiance / ls.pdf;
-                }
-            }
+            radiance += beta * connect(m, frame, wo, eta, point, ng, ls) / max(ls.pdf, 1e-30);
         }
 
         // BSDF sample: continues the path (and finds emitters for the MIS estimator).

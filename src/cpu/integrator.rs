@@ -4,14 +4,14 @@ use super::bsdf::{bsdf_eval, bsdf_pdf, bsdf_sample};
 use super::bvh::{INF, NO_HIT, Ray, intersect_closest, occluded, offset_ray};
 use super::camera::generate_ray;
 use super::environment::{environment_pdf, environment_radiance};
-use super::frame::{frame_from_normal, from_local, to_local};
+use super::frame::{Frame, frame_from_normal, from_local, to_local};
 use super::instance::world_triangle;
 use super::lights::{LightSample, light_pdf, sample_light, sample_punctual};
 use super::material::{material_at, shading_normal, triangle_uv};
 use super::mis::mis_weight;
 use super::rng::{rng_init, rng_next, rng_next2};
 use crate::Strategy;
-use crate::packed::{PackedScene, TRI_MIRRORED};
+use crate::packed::{PackedMaterial, PackedScene, TRI_MIRRORED};
 use crate::params::Params;
 use glam::{UVec2, Vec3};
 
@@ -21,6 +21,32 @@ fn same_side(wi: Vec3, ng: Vec3, wi_local: Vec3) -> bool {
 
 fn spawn_point(point: Vec3, ng: Vec3, wi: Vec3) -> Vec3 {
     offset_ray(point, if wi.dot(ng) > 0.0 { ng } else { -ng })
+}
+
+/// Twin of `connect` in the shader: f · |cos θ| · L, or 0 (blocked, zero BSDF, no density).
+#[allow(clippy::too_many_arguments)]
+fn connect(
+    scene: &PackedScene,
+    m: &PackedMaterial,
+    frame: &Frame,
+    wo: Vec3,
+    eta: f32,
+    point: Vec3,
+    ng: Vec3,
+    ls: &LightSample,
+) -> Vec3 {
+    if ls.pdf <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let wi_local = to_local(frame, ls.wi);
+    let f = bsdf_eval(m, wo, wi_local, eta);
+    if !same_side(ls.wi, ng, wi_local)
+        || f.max_element() <= 0.0
+        || !unoccluded(scene, spawn_point(point, ng, ls.wi), ls)
+    {
+        return Vec3::ZERO;
+    }
+    f * wi_local.z.abs() * ls.radiance
 }
 
 fn unoccluded(scene: &PackedScene, origin: Vec3, ls: &LightSample) -> bool {
@@ -96,34 +122,19 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
             let u0 = rng_next(rng);
             let u12 = rng_next2(rng);
             let ls = sample_light(scene, params, point, Vec3::new(u0, u12.x, u12.y));
-            if ls.pdf > 0.0 {
-                let wi_local = to_local(&frame, ls.wi);
-                let f = bsdf_eval(m, wo, wi_local, eta);
-                if same_side(ls.wi, ng, wi_local)
-                    && f.max_element() > 0.0
-                    && unoccluded(scene, spawn_point(point, ng, ls.wi), &ls)
-                {
-                    let w = if strategy == Strategy::Light {
-                        1.0
-                    } else {
-                        mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, wi_local, eta))
-                    };
-                    radiance += beta * f * wi_local.z.abs() * ls.radiance * (w / ls.pdf);
-                }
+            let c = connect(scene, m, &frame, wo, eta, point, ng, &ls);
+            if c.max_element() > 0.0 {
+                let w = if strategy == Strategy::Light {
+                    1.0
+                } else {
+                    mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, to_local(&frame, ls.wi), eta))
+                };
+                radiance += beta * c * (w / ls.pdf);
             }
         }
         if params.punctual_count > 0 {
             let ls = sample_punctual(scene, params, point, rng_next(rng));
-            if ls.pdf > 0.0 {
-                let wi_local = to_local(&frame, ls.wi);
-                let f = bsdf_eval(m, wo, wi_local, eta);
-                if same_side(ls.wi, ng, wi_local)
-                    && f.max_element() > 0.0
-                    && unoccluded(scene, spawn_point(point, ng, ls.wi), &ls)
-                {
-                    radiance += beta * f * wi_local.z.abs() * ls.radiance / ls.pdf;
-                }
-            }
+            radiance += beta * connect(scene, m, &frame, wo, eta, point, ng, &ls) / ls.pdf.max(1e-30);
         }
 
         let u0 = rng_next(rng);
