@@ -1,10 +1,10 @@
 // Camera rays: jittered uniformly inside the pixel (box filter); a pinhole, or a thin lens
 // focused at params.focus_distance when params.aperture > 0. Twin: src/cpu/camera.rs.
 #include "bindings.wgsl"
-#include "rng.wgsl"
+#include "sampler.wgsl"
 #include "sampling.wgsl"
 
-fn generate_ray(pixel: vec2<u32>, u: vec2<f32>, rng: ptr<function, u32>) -> Ray {
+fn generate_ray(pixel: vec2<u32>, u: vec2<f32>, sampler: ptr<function, Sampler>) -> Ray {
     let x = (f32(pixel.x) + u.x) / f32(params.image_width) * 2.0 - 1.0;
     let y = 1.0 - (f32(pixel.y) + u.y) / f32(params.image_height) * 2.0;
     let dir = normalize(params.cam_forward + x * params.cam_right + y * params.cam_up);
@@ -13,7 +13,7 @@ fn generate_ray(pixel: vec2<u32>, u: vec2<f32>, rng: ptr<function, u32>) -> Ray 
     }
     // Every ray through the lens meets the pinhole ray on the plane in focus.
     let focus = params.cam_position + dir * (params.focus_distance / dot(dir, params.cam_forward));
-    let lens = sample_uniform_disk(rng_next2(rng)) * params.aperture;
+    let lens = sample_uniform_disk(sample_2d(sampler)) * params.aperture;
     let origin = params.cam_position + lens.x * normalize(params.cam_right) + lens.y * normalize(params.cam_up);
     return Ray(origin, normalize(focus - origin));
 }

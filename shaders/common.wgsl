@@ -144,7 +144,8 @@ struct Params {
     punctual_count: u32,
     // First instance record in the node array (two-level BVH).
     instance_base: u32,
-    pad0: u32,
+    // SAMPLER_INDEPENDENT or SAMPLER_SOBOL (sampler.wgsl).
+    sampler: u32,
     pad1: u32,
     pad2: u32,
 }

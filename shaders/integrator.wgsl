@@ -1,7 +1,7 @@
 // The path tracer: one sample per pixel per dispatch, next-event estimation at every vertex
 // combined with BSDF sampling by MIS (or either strategy alone). Twin: src/cpu/integrator.rs.
 #include "bindings.wgsl"
-#include "rng.wgsl"
+#include "sampler.wgsl"
 #include "frame.wgsl"
 #include "bvh.wgsl"
 #include "camera.wgsl"
@@ -46,7 +46,7 @@ fn unoccluded(origin: vec3<f32>, ls: LightSample) -> bool {
 }
 
 // Radiance arriving along a camera ray. Path depth counts segments (Mitsuba's max_depth).
-fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
+fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
     let strategy = params.strategy;
     var radiance = vec3<f32>(0.0);
     var beta = vec3<f32>(1.0);
@@ -108,7 +108,7 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
 
         // Next-event estimation: one light sample.
         if (strategy != STRATEGY_BSDF && (params.light_count > 0u || params.env_select > 0.0)) {
-            let u_light = vec3<f32>(rng_next(rng), rng_next2(rng));
+            let u_light = vec3<f32>(sample_1d(sampler), sample_2d(sampler));
             let ls = sample_light(point, u_light);
             let c = connect(m, frame, wo, eta, point, ng, ls);
             if (max_component(c) > 0.0) {
@@ -121,12 +121,12 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
         }
         // Punctual lights: only next-event estimation can reach them, whatever the strategy.
         if (PUNCTUAL_LIGHTS && params.punctual_count > 0u) {
-            let ls = sample_punctual(point, rng_next(rng));
+            let ls = sample_punctual(point, sample_1d(sampler));
             radiance += beta * connect(m, frame, wo, eta, point, ng, ls) / max(ls.pdf, 1e-30);
         }
 
         // BSDF sample: continues the path (and finds emitters for the MIS estimator).
-        let u_bsdf = vec3<f32>(rng_next(rng), rng_next2(rng));
+        let u_bsdf = vec3<f32>(sample_1d(sampler), sample_2d(sampler));
         let bs = bsdf_sample(m, wo, u_bsdf, eta);
         if (bs.pdf <= 0.0) {
             break;
@@ -146,7 +146,7 @@ fn li(camera_ray: Ray, rng: ptr<function, u32>) -> vec3<f32> {
 
         if (depth >= params.rr_depth) {
             let q = min(max_component(beta), 0.95);
-            if (rng_next(rng) >= q) {
+            if (sample_1d(sampler) >= q) {
                 break;
             }
             beta /= q;
@@ -162,7 +162,7 @@ fn render_sample(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let pixel = vec2<u32>(gid.x + params.tile_x, row + params.tile_y);
-    var rng = rng_init(pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
-    let ray = generate_ray(pixel, rng_next2(&rng), &rng);
-    film_add_sample(row * params.film_width + gid.x, li(ray, &rng));
+    var sampler = sampler_init(params.sampler, pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
+    let ray = generate_ray(pixel, sample_2d(&sampler), &sampler);
+    film_add_sample(row * params.film_width + gid.x, li(ray, &sampler));
 }

@@ -5,6 +5,7 @@
 use crate::cpu::bvh::{Ray, intersect_closest, occluded, offset_ray};
 use crate::cpu::frame::{frame_from_normal, from_local};
 use crate::cpu::rng::{rng_init, rng_next2};
+use crate::cpu::sampler::{sample_2d, sampler_init};
 use crate::cpu::sampling::{sample_cosine_hemisphere, sample_uniform_triangle};
 use crate::packed::PackedScene;
 use crate::{Backend, Error, Renderer, Settings, gpu};
@@ -142,10 +143,10 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<Ra
     };
     let primary: Vec<Ray> = (0..w * h)
         .map(|i| {
-            let mut rng = rng_init(i, 0, 1);
+            let mut sampler = sampler_init(params.sampler, i, 0, 1);
             let pixel = glam::UVec2::new(i % w, i / w);
-            let jitter = rng_next2(&mut rng);
-            crate::cpu::camera::generate_ray(params, pixel, jitter, &mut rng)
+            let jitter = sample_2d(&mut sampler);
+            crate::cpu::camera::generate_ray(params, pixel, jitter, &mut sampler)
         })
         .collect();
     let t = Instant::now();

@@ -75,6 +75,18 @@ impl Strategy {
     }
 }
 
+/// How the numbers of a path's decisions are generated (`shaders/sampler.wgsl`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+#[repr(u32)]
+pub enum SamplerKind {
+    /// Independent uniform numbers (PCG); the default of renders saved before samplers existed.
+    #[default]
+    Independent = 0,
+    /// Owen-scrambled Sobol', padded per 2D pair: lower error at equal spp.
+    Sobol = 1,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Backend {
     Gpu,
@@ -97,6 +109,7 @@ pub struct Settings {
     pub max_depth: u32,
     pub seed: u32,
     pub strategy: Strategy,
+    pub sampler: SamplerKind,
     pub camera: Option<String>,
     /// Overrides the scene's environment radiance.
     pub environment: Option<Vec3>,
@@ -115,6 +128,7 @@ impl Default for Settings {
             max_depth: 8,
             seed: 0,
             strategy: Strategy::MisPower,
+            sampler: SamplerKind::Sobol,
             camera: None,
             environment: None,
             tile: None,
@@ -137,6 +151,7 @@ fn make_params(scene: &PackedScene, camera: &scene::Camera, settings: &Settings,
             _ => cpu::camera::autofocus(scene, &params),
         };
     }
+    params.sampler = settings.sampler as u32;
     params
 }
 
@@ -163,6 +178,9 @@ pub struct Job {
     pub aperture: f32,
     #[serde(default)]
     pub focus_distance: Option<f32>,
+    /// Renders saved before samplers existed used independent numbers.
+    #[serde(default)]
+    pub sampler: SamplerKind,
 }
 
 impl Job {
@@ -173,6 +191,7 @@ impl Job {
             max_depth: self.max_depth,
             seed: self.seed,
             strategy: self.strategy,
+            sampler: self.sampler,
             camera: self.camera.clone(),
             environment: None,
             tile: self.tile,

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 use veach::film::Film;
 use veach::tonemap::Tonemap;
-use veach::{Backend, Error, Job, Renderer, Settings, Strategy, Tile};
+use veach::{Backend, Error, Job, Renderer, SamplerKind, Settings, Strategy, Tile};
 
 #[derive(Parser)]
 #[command(
@@ -219,6 +219,9 @@ struct RenderArgs {
     /// Direct-lighting estimator.
     #[arg(long, value_enum, default_value_t = Strategy::MisPower)]
     strategy: Strategy,
+    /// Sample generator: sobol (Owen-scrambled, lower error at equal spp) or independent.
+    #[arg(long, value_enum, default_value_t = SamplerKind::Sobol)]
+    sampler: SamplerKind,
     /// gpu (Vulkan; falls back to cpu with a warning when no adapter exists unless given explicitly) or cpu.
     #[arg(long, value_enum)]
     backend: Option<Backend>,
@@ -390,6 +393,7 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
                 sample_end,
                 aperture: args.look.aperture,
                 focus_distance: args.look.focus_distance,
+                sampler: args.sampler,
             };
             (job, None)
         }
@@ -511,6 +515,7 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
             "max_depth": job.max_depth,
             "seed": job.seed,
             "strategy": job.strategy,
+            "sampler": job.sampler,
             "adapter": renderer.adapter_name(),
             "backend": format!("{:?}", renderer.backend()).to_lowercase(),
             "seconds_total": t0.elapsed().as_secs_f64(),
@@ -654,11 +659,20 @@ fn merge(args: &MergeArgs) -> Result<Outcome, Error> {
     let mut merged = Film::new(job.width, job.height);
     let mut seen: Vec<(Tile, u32, u32, &Path)> = Vec::new();
     for ((film, part), path) in parts.iter().zip(&args.parts) {
-        let same = (part.width, part.height, part.seed, part.max_depth, part.strategy, &part.scene, &part.camera)
-            == (job.width, job.height, job.seed, job.max_depth, job.strategy, &job.scene, &job.camera);
+        let same =
+            (
+                part.width,
+                part.height,
+                part.seed,
+                part.max_depth,
+                part.strategy,
+                part.sampler,
+                &part.scene,
+                &part.camera,
+            ) == (job.width, job.height, job.seed, job.max_depth, job.strategy, job.sampler, &job.scene, &job.camera);
         if !same {
             return Err(Error::Input(format!(
-                "{}: rendered with other settings than {} (scene, size, seed, depth, strategy and camera must match)",
+                "{}: rendered with other settings than {} (scene, size, seed, depth, strategy, sampler and camera must match)",
                 path.display(),
                 args.parts[0].display()
             )));
@@ -752,6 +766,7 @@ fn strategies(args: &StrategiesArgs) -> Result<(), Error> {
             max_depth: args.max_depth,
             seed: args.seed,
             strategy,
+            sampler: SamplerKind::Sobol,
             camera: args.look.camera.clone(),
             environment: None,
             tile: None,

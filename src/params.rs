@@ -43,7 +43,9 @@ pub struct Params {
     pub punctual_count: u32,
     /// First instance record in the node array (when the scene has instances).
     pub instance_base: u32,
-    pub pad: [u32; 3],
+    /// How samples are generated: `cpu::sampler::SAMPLER_INDEPENDENT` or `SAMPLER_SOBOL`.
+    pub sampler: u32,
+    pub pad: [u32; 2],
 }
 
 /// Russian roulette starts once a path has this many segments.
@@ -105,7 +107,8 @@ impl Params {
             punctual_base: scene.punctual_base,
             punctual_count: scene.punctual_count,
             instance_base: scene.instance_base,
-            pad: [0; 3],
+            sampler: crate::cpu::sampler::SAMPLER_SOBOL,
+            pad: [0; 2],
         }
     }
 }

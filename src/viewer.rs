@@ -275,7 +275,12 @@ impl Viewer {
                 (uv.x * self.settings.width as f32).max(0.0) as u32,
                 (uv.y * self.settings.height as f32).max(0.0) as u32,
             );
-            let ray = crate::cpu::camera::generate_ray(&params, pixel, glam::Vec2::splat(0.5), &mut 0);
+            let ray = crate::cpu::camera::generate_ray(
+                &params,
+                pixel,
+                glam::Vec2::splat(0.5),
+                &mut crate::cpu::sampler::sampler_init(0, 0, 0, 0),
+            );
             let hit = crate::cpu::bvh::intersect_closest(r.scene(), &ray);
             if hit.tri != crate::cpu::bvh::NO_HIT {
                 self.settings.focus_distance = Some(hit.t * ray.dir.dot(Vec3::from(params.cam_forward)));

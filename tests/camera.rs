@@ -6,6 +6,7 @@ mod common;
 use common::*;
 use glam::{UVec2, Vec2, Vec3};
 use veach::cpu::camera::{autofocus, generate_ray};
+use veach::cpu::sampler::{SAMPLER_SOBOL, sampler_init};
 use veach::packed::PackedScene;
 use veach::params::Params;
 use veach::{Strategy, Tile};
@@ -28,9 +29,8 @@ fn lens_rays_meet_on_the_plane_in_focus() {
     for k in 0..200u32 {
         let pixel = UVec2::new(k * 7 % 64, k * 13 % 48);
         let jitter = Vec2::new((k as f32 * 0.37).fract(), (k as f32 * 0.61).fract());
-        let centre = generate_ray(&pinhole, pixel, jitter, &mut 0);
-        let mut rng = k;
-        let r = generate_ray(&lens, pixel, jitter, &mut rng);
+        let centre = generate_ray(&pinhole, pixel, jitter, &mut sampler_init(SAMPLER_SOBOL, 0, 0, 0));
+        let r = generate_ray(&lens, pixel, jitter, &mut sampler_init(SAMPLER_SOBOL, k, 0, 0));
         assert!(r.origin.distance(centre.origin) <= 25.0 + 1e-3 && r.origin != centre.origin);
         // Both rays reach the plane at distance 1000 along the view direction at one point.
         let at = |ray: &veach::cpu::bvh::Ray| {

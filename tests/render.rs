@@ -93,14 +93,21 @@ fn gpu_and_cpu_agree_in_distribution() {
 fn gpu_and_cpu_trace_the_same_paths() {
     // Same seed: both backends draw the same random numbers, so apart from float rounding
     // (which can flip a rare path) they compute the same pixels.
-    let Some(ctx) = gpu("gpu_and_cpu_trace_the_same_paths") else { return };
-    let s = settings(32, 8, 9);
-    let g = render(&asset("cornell-box.gltf"), &s, 16, Some(ctx));
-    let c = render(&asset("cornell-box.gltf"), &s, 16, None);
-    let close = (0..g.pixel_count())
-        .filter(|&i| (g.mean(i) - c.mean(i)).abs().max_element() <= 1e-3 * c.mean(i).max_element().max(1e-3))
-        .count();
-    assert!(close as f64 >= 0.98 * g.pixel_count() as f64, "only {close}/{} pixels match", g.pixel_count());
+    // Both sample generators (shaders/sampler.wgsl and its twin) are checked.
+    for sampler in [veach::SamplerKind::Independent, veach::SamplerKind::Sobol] {
+        let Some(ctx) = gpu("gpu_and_cpu_trace_the_same_paths") else { return };
+        let s = veach::Settings { sampler, ..settings(32, 8, 9) };
+        let g = render(&asset("cornell-box.gltf"), &s, 16, Some(ctx));
+        let c = render(&asset("cornell-box.gltf"), &s, 16, None);
+        let close = (0..g.pixel_count())
+            .filter(|&i| (g.mean(i) - c.mean(i)).abs().max_element() <= 1e-3 * c.mean(i).max_element().max(1e-3))
+            .count();
+        assert!(
+            close as f64 >= 0.98 * g.pixel_count() as f64,
+            "{sampler:?}: only {close}/{} pixels match",
+            g.pixel_count()
+        );
+    }
 }
 
 fn furnace(ctx: Option<veach::gpu::GpuContext>, what: &str) {

@@ -1,12 +1,12 @@
 //! Twin of `shaders/camera.wgsl`.
 
 use super::bvh::Ray;
-use super::rng::rng_next2;
+use super::sampler::{Sampler, sample_2d};
 use super::sampling::sample_uniform_disk;
 use crate::params::Params;
 use glam::{UVec2, Vec2, Vec3};
 
-pub fn generate_ray(params: &Params, pixel: UVec2, u: Vec2, rng: &mut u32) -> Ray {
+pub fn generate_ray(params: &Params, pixel: UVec2, u: Vec2, sampler: &mut Sampler) -> Ray {
     let x = (pixel.x as f32 + u.x) / params.image_width as f32 * 2.0 - 1.0;
     let y = 1.0 - (pixel.y as f32 + u.y) / params.image_height as f32 * 2.0;
     let (forward, right, up) =
@@ -17,7 +17,7 @@ pub fn generate_ray(params: &Params, pixel: UVec2, u: Vec2, rng: &mut u32) -> Ra
         return Ray { origin: position, dir };
     }
     let focus = position + dir * (params.focus_distance / dir.dot(forward));
-    let lens = sample_uniform_disk(rng_next2(rng)) * params.aperture;
+    let lens = sample_uniform_disk(sample_2d(sampler)) * params.aperture;
     let origin = position + lens.x * right.normalize() + lens.y * up.normalize();
     Ray { origin, dir: (focus - origin).normalize() }
 }

@@ -9,7 +9,7 @@ use super::instance::world_triangle;
 use super::lights::{LightSample, light_pdf, sample_light, sample_punctual};
 use super::material::{material_at, shading_normal, triangle_uv};
 use super::mis::mis_weight;
-use super::rng::{rng_init, rng_next, rng_next2};
+use super::sampler::{Sampler, sample_1d, sample_2d, sampler_init};
 use crate::Strategy;
 use crate::packed::{PackedMaterial, PackedScene, TRI_MIRRORED};
 use crate::params::Params;
@@ -57,7 +57,7 @@ fn unoccluded(scene: &PackedScene, origin: Vec3, ls: &LightSample) -> bool {
     !occluded(scene, &Ray { origin, dir: target - origin }, 1.0)
 }
 
-pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) -> Vec3 {
+pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut Sampler) -> Vec3 {
     let strategy = Strategy::from_u32(params.strategy);
     let mut radiance = Vec3::ZERO;
     let mut beta = Vec3::ONE;
@@ -119,8 +119,8 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
         let wo = to_local(&frame, -ray.dir);
 
         if strategy != Strategy::Bsdf && (params.light_count > 0 || params.env_select > 0.0) {
-            let u0 = rng_next(rng);
-            let u12 = rng_next2(rng);
+            let u0 = sample_1d(sampler);
+            let u12 = sample_2d(sampler);
             let ls = sample_light(scene, params, point, Vec3::new(u0, u12.x, u12.y));
             let c = connect(scene, m, &frame, wo, eta, point, ng, &ls);
             if c.max_element() > 0.0 {
@@ -133,12 +133,12 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
             }
         }
         if params.punctual_count > 0 {
-            let ls = sample_punctual(scene, params, point, rng_next(rng));
+            let ls = sample_punctual(scene, params, point, sample_1d(sampler));
             radiance += beta * connect(scene, m, &frame, wo, eta, point, ng, &ls) / ls.pdf.max(1e-30);
         }
 
-        let u0 = rng_next(rng);
-        let u12 = rng_next2(rng);
+        let u0 = sample_1d(sampler);
+        let u12 = sample_2d(sampler);
         let bs = bsdf_sample(m, wo, Vec3::new(u0, u12.x, u12.y), eta);
         if bs.pdf <= 0.0 {
             break;
@@ -157,7 +157,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
 
         if depth >= params.rr_depth {
             let q = beta.max_element().min(0.95);
-            if rng_next(rng) >= q {
+            if sample_1d(sampler) >= q {
                 break;
             }
             beta /= q;
@@ -169,8 +169,9 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, rng: &mut u32) 
 /// Sample `params.sample_index` of one film pixel; returns the radiance (possibly non-finite).
 pub fn render_sample(scene: &PackedScene, params: &Params, x: u32, y: u32) -> Vec3 {
     let pixel = UVec2::new(x + params.tile_x, y + params.tile_y);
-    let mut rng = rng_init(pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
-    let jitter = rng_next2(&mut rng);
-    let ray = generate_ray(params, pixel, jitter, &mut rng);
-    li(scene, params, ray, &mut rng)
+    let mut sampler =
+        sampler_init(params.sampler, pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
+    let jitter = sample_2d(&mut sampler);
+    let ray = generate_ray(params, pixel, jitter, &mut sampler);
+    li(scene, params, ray, &mut sampler)
 }

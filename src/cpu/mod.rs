@@ -15,6 +15,7 @@ pub mod material;
 pub mod microfacet;
 pub mod mis;
 pub mod rng;
+pub mod sampler;
 pub mod sampling;
 pub mod texture;
 

@@ -6,6 +6,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../../shaders/common.wgsl")),
     ("bindings.wgsl", include_str!("../../shaders/bindings.wgsl")),
     ("rng.wgsl", include_str!("../../shaders/rng.wgsl")),
+    ("sampler.wgsl", include_str!("../../shaders/sampler.wgsl")),
     ("sampling.wgsl", include_str!("../../shaders/sampling.wgsl")),
     ("frame.wgsl", include_str!("../../shaders/frame.wgsl")),
     ("mis.wgsl", include_str!("../../shaders/mis.wgsl")),

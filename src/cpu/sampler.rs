@@ -1,0 +1,74 @@
+//! Twin of `shaders/sampler.wgsl`: independent and Owen-scrambled Sobol' samples, bit-identical
+//! to the kernel's.
+
+use super::rng::{pcg_hash, rng_init, rng_next};
+use glam::Vec2;
+
+pub const SAMPLER_INDEPENDENT: u32 = 0;
+pub const SAMPLER_SOBOL: u32 = 1;
+
+pub struct Sampler {
+    kind: u32,
+    pixel_seed: u32,
+    index: u32,
+    dim: u32,
+    state: u32,
+}
+
+pub fn sampler_init(kind: u32, pixel: u32, sample_index: u32, seed: u32) -> Sampler {
+    let pixel_seed = pcg_hash(pixel ^ pcg_hash(seed ^ 0x5bd1e995));
+    Sampler { kind, pixel_seed, index: sample_index, dim: 0, state: rng_init(pixel, sample_index, seed) }
+}
+
+pub fn owen_scramble(v: u32, seed: u32) -> u32 {
+    let mut x = v.reverse_bits();
+    x ^= x.wrapping_mul(0x3d20adea);
+    x = x.wrapping_add(seed);
+    x = x.wrapping_mul((seed >> 16) | 1);
+    x ^= x.wrapping_mul(0x05526c56);
+    x ^= x.wrapping_mul(0x53a22864);
+    x.reverse_bits()
+}
+
+pub fn sobol_1_from_0(x: u32) -> u32 {
+    let mut y = x;
+    y ^= (y << 1) & 0xaaaa_aaaa;
+    y ^= (y << 2) & 0xcccc_cccc;
+    y ^= (y << 4) & 0xf0f0_f0f0;
+    y ^= (y << 8) & 0xff00_ff00;
+    y ^= (y << 16) & 0xffff_0000;
+    y
+}
+
+fn unit_float(bits: u32) -> f32 {
+    (bits >> 8) as f32 * (1.0 / 16777216.0)
+}
+
+fn next_dimension_seed(s: &mut Sampler) -> u32 {
+    let d = pcg_hash(s.pixel_seed ^ pcg_hash(s.dim));
+    s.dim += 1;
+    d
+}
+
+pub fn sample_1d(s: &mut Sampler) -> f32 {
+    if s.kind == SAMPLER_INDEPENDENT {
+        return rng_next(&mut s.state);
+    }
+    let d = next_dimension_seed(s);
+    let i = owen_scramble(s.index, d);
+    unit_float(owen_scramble(i.reverse_bits(), pcg_hash(d ^ 1)))
+}
+
+pub fn sample_2d(s: &mut Sampler) -> Vec2 {
+    if s.kind == SAMPLER_INDEPENDENT {
+        let a = rng_next(&mut s.state);
+        let b = rng_next(&mut s.state);
+        return Vec2::new(a, b);
+    }
+    let d = next_dimension_seed(s);
+    let i = owen_scramble(s.index, d);
+    let sobol_0 = i.reverse_bits();
+    let x = owen_scramble(sobol_0, pcg_hash(d ^ 1));
+    let y = owen_scramble(sobol_1_from_0(sobol_0), pcg_hash(d ^ 2));
+    Vec2::new(unit_float(x), unit_float(y))
+}
