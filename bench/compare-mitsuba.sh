@@ -19,7 +19,11 @@
 #   --backends LIST     veach backends (default gpu,cpu; "" = no veach)
 #   --rmse              write every image as EXR (Mitsuba: mi.util.write_bitmap) and print the
 #                       image means and RMSE against mitsuba-llvm and, where one fits the
-#                       settings, against the shared reference render
+#                       settings, against the shared reference render; where a reference fits
+#                       (cbox at depth 8 or 0, veach at depth 2, 256x256), also the error at
+#                       equal time: veach records --reference series, Mitsuba renders 1, 2, 4,
+#                       ... spp (each timed warm), and the report interpolates both to the same
+#                       times; plots go to OUT_DIR/convergence_SCENE.png (veach plot-convergence)
 #   --out-dir DIR       where the images and stats go (default: a temp dir, removed unless --rmse)
 #   --json FILE         also write all numbers plus machine info (nproc, CPU model, date) as JSON
 # Environment:
@@ -157,6 +161,20 @@ if awk -v l="$load" 'BEGIN { exit !(l > 0.5) }'; then
 fi
 echo "settings: ${size}x${size}, $spp spp, max depth $depth, seed $seed, $repeat timed run(s); scenes ${scene_list[*]} from $scenes_dir" >&2
 
+# The shared reference render that fits a scene at these settings (as reference_for in
+# mitsuba_scenes.py), or nothing.
+reference_for() {
+  local f=""
+  (( size == 256 )) || return 0
+  case "$1:$depth" in
+    cbox:8) f=cbox_ref_d8.exr ;;
+    cbox:0) f=cbox_ref.exr ;;
+    veach:2) f=veach_ref.exr ;;
+  esac
+  [[ -n $f && -f $scenes_dir/$f ]] && echo "$scenes_dir/$f"
+  return 0
+}
+
 # ---- veach ----------------------------------------------------------------------------------
 veach_tsv="$out_dir/veach_runs.tsv"
 : > "$veach_tsv"
@@ -171,8 +189,11 @@ if [[ ${#backend_list[@]} -gt 0 ]]; then
       for ((i = 1; i <= repeat; i++)); do
         stats="$out_dir/${s}_veach-${b}_$i.json"
         img="$out_dir/${s}_veach-${b}.$ext"
+        ref_args=()
+        ref=$(reference_for "$s")
+        [[ $rmse == 1 && -n $ref ]] && ref_args=(--reference "$ref")
         if ! "$veach_bin" render "$scenes_dir/$s.gltf" --backend "$b" --width "$size" --height "$size" \
-            --spp "$spp" --max-depth "$depth" --seed "$seed" --stats-json "$stats" -o "$img" \
+            --spp "$spp" --max-depth "$depth" --seed "$seed" --stats-json "$stats" -o "$img" "${ref_args[@]}" \
             > "$out_dir/veach.log" 2>&1; then
           cat "$out_dir/veach.log" >&2
           die "veach render failed: $s, backend $b"
@@ -191,7 +212,11 @@ mitsuba_json="$out_dir/mitsuba.json"
 scene_args=()
 for s in "${scene_list[@]}"; do scene_args+=(--scene "$s"); done
 exr_args=()
-[[ $rmse == 1 ]] && exr_args=(--exr-dir "$out_dir")
+if [[ $rmse == 1 ]]; then
+  # Mitsuba's error series reaches at least veach's longest render time.
+  longest=$(cat "$out_dir"/*_veach-*.json 2>/dev/null | sed -n 's/.*"seconds_render": *\([0-9.eE+-]*\).*/\1/p' | sort -g | tail -1)
+  exr_args=(--exr-dir "$out_dir" --ref-dir "$scenes_dir" --series-seconds "${longest:-0}")
+fi
 if [[ -n $variants ]]; then
   echo "mitsuba: $("$py" -c 'import mitsuba; print(mitsuba.__version__)') in $venv, variants $variants${DRJIT_LIBLLVM_PATH:+, LLVM $DRJIT_LIBLLVM_PATH}" >&2
 fi
@@ -201,9 +226,15 @@ fi
 
 # ---- report ---------------------------------------------------------------------------------
 report_args=(--mitsuba "$mitsuba_json" --veach-runs "$veach_tsv")
-[[ $rmse == 1 ]] && report_args+=(--ref-dir "$scenes_dir")
+[[ $rmse == 1 ]] && report_args+=(--ref-dir "$scenes_dir" --series-dir "$out_dir")
 [[ -n $json_out ]] && report_args+=(--json "$json_out")
 "$py" "$here/mitsuba_scenes.py" report "${report_args[@]}"
 if [[ $rmse == 1 ]]; then
+  for s in "${scene_list[@]}"; do
+    files=("$out_dir/${s}"_*.series.json)
+    [[ -f ${files[0]} ]] || continue
+    "$veach_bin" plot-convergence "${files[@]}" -o "$out_dir/convergence_$s.png" >/dev/null 2>&1 \
+      && echo "error against time: $out_dir/convergence_$s.png"
+  done
   echo "images and stats kept in $out_dir"
 fi

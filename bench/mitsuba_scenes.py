@@ -171,6 +171,31 @@ def render_once(scene, spp, seed):
     return time.perf_counter() - t0, arr
 
 
+def reference_for(name, max_depth):
+    """The shared reference render that fits a scene at a max depth, or None."""
+    return {"cbox": {8: "cbox_ref_d8.exr", 0: "cbox_ref.exr"}.get(max_depth),
+            "veach": "veach_ref.exr" if max_depth == 2 else None}.get(name)
+
+
+def convergence_series(scene, spp, seed, reference, until_seconds=0.0):
+    """RMSE against `reference` of renders at 1, 2, 4, ... spp, each timed after a warm-up at the
+    same spp (the llvm variant compiles a kernel per setting): the error a user gets for the
+    time spent, in the same form as veach's --reference series. Goes on doubling past `spp`
+    until a render takes `until_seconds` (the other renderer's longest time; at most 16384 spp)."""
+    import numpy as np
+
+    series = []
+    n = 1
+    while True:
+        render_once(scene, n, seed)
+        secs, img = render_once(scene, n, seed)
+        rmse = float(np.sqrt(np.mean((img[:, :, :3].astype(np.float64) - reference) ** 2)))
+        series.append({"spp": n, "seconds": secs, "rmse": rmse})
+        if (n >= spp and secs >= until_seconds) or n >= 16384:
+            return series
+        n *= 2
+
+
 def cmd_bench(a):
     import mitsuba as mi
     import numpy as np
@@ -220,6 +245,12 @@ def cmd_bench(a):
                 "samples_per_second": samples / med,
                 "mean_rgb": mean,
             }
+            ref_name = reference_for(name, a.depth)
+            if a.ref_dir and ref_name and os.path.exists(os.path.join(a.ref_dir, ref_name)):
+                ref = read_rgb(os.path.join(a.ref_dir, ref_name))
+                if ref.shape[:2] == (a.size, a.size):
+                    rec["reference"] = ref_name
+                    rec["convergence"] = convergence_series(scene, a.spp, a.seed, ref, a.series_seconds)
             if a.exr_dir:
                 os.makedirs(a.exr_dir, exist_ok=True)
                 path = os.path.join(a.exr_dir, f"{name}_{rec['renderer']}.exr")
@@ -328,8 +359,7 @@ def cmd_report(a):
     if a.ref_dir:
         for r in runs:
             name = r["scene"]
-            cand = {"cbox": {8: "cbox_ref_d8.exr", 0: "cbox_ref.exr"}.get(s["max_depth"]),
-                    "veach": "veach_ref.exr" if s["max_depth"] == 2 else None}.get(name)
+            cand = reference_for(name, s["max_depth"])
             if cand and name not in refs and os.path.exists(os.path.join(a.ref_dir, cand)):
                 ref = read_rgb(os.path.join(a.ref_dir, cand))
                 if ref.shape[0] == s["height"] and ref.shape[1] == s["width"]:
@@ -379,6 +409,7 @@ def cmd_report(a):
                 line += f"  {a1:12.4f}" if a1 is not None else f"  {'':12s}"
                 line += f" {a2:11.4f}" if a2 is not None else ""
             print(line)
+    equal_time = report_equal_time(scenes, by, a.series_dir)
     print()
     ratios = []
     print(f"{'scene':8s} {'veach-gpu / mitsuba-llvm':>25s} {'veach-cpu / mitsuba-scalar':>27s}")
@@ -403,10 +434,68 @@ def cmd_report(a):
             "veach": {k: v for k, v in veach.items() if k != "runs"},
             "runs": runs,
             "ratios": ratios,
+            "equal_time": equal_time,
         }
         with open(a.json, "w") as f:
             json.dump(doc, f, indent=1)
         print(f"\nwrote {a.json}")
+
+
+def rmse_at(series, t):
+    """RMSE at time t on the log-log line through the series' neighbouring points (None outside)."""
+    import math
+
+    pts = sorted((p["seconds"], p["rmse"]) for p in series if p["seconds"] > 0 and p["rmse"] > 0)
+    for (t0, e0), (t1, e1) in zip(pts, pts[1:]):
+        if t0 <= t <= t1:
+            if t1 == t0:
+                return e0
+            f = (math.log(t) - math.log(t0)) / (math.log(t1) - math.log(t0))
+            return math.exp(math.log(e0) + f * (math.log(e1) - math.log(e0)))
+    return None
+
+
+def report_equal_time(scenes, by, series_dir):
+    """Per scene: every renderer's RMSE at 1 s and when each veach render ended; the
+    series are also written as stats-like JSON files for `veach plot-convergence`."""
+    order = ["veach-gpu", "veach-cpu", "mitsuba-llvm", "mitsuba-scalar"]
+    out = []
+    for sc in scenes:
+        series = {}
+        for rn in order:
+            r = by.get((sc, rn))
+            conv = r and (r.get("convergence") or (r.get("stats") or {}).get("convergence"))
+            if conv:
+                series[rn] = conv
+        if len(series) < 2:
+            continue
+        if series_dir:
+            for rn, conv in series.items():
+                with open(os.path.join(series_dir, f"{sc}_{rn}.series.json"), "w") as f:
+                    json.dump({"backend": rn, "scene": sc, "convergence": conv}, f, indent=1)
+        # At 1 s and at the end of each veach render; a cell stays empty where a series does
+        # not reach that time.
+        ends = [max(p["seconds"] for p in conv) for rn, conv in series.items() if rn.startswith("veach")]
+        times = sorted({1.0, *ends})
+        for t in times:
+            row = {"scene": sc, "seconds": t}
+            for rn, conv in series.items():
+                row[rn] = rmse_at(conv, t)
+            out.append(row)
+    if out:
+        print()
+        print("RMSE against the shared reference at equal render time (log-log interpolation between")
+        print("the renders at 1, 2, 4, ... spp; lower is better)")
+        hdr = f"{'scene':8s} {'seconds':>8s}" + "".join(f" {rn:>15s}" for rn in order)
+        hdr += f" {'gpu / llvm':>11s} {'cpu / scalar':>13s}"
+        print(hdr)
+        print("-" * len(hdr))
+        for row in out:
+            cells = "".join(f" {row[rn]:15.5f}" if row.get(rn) else f" {'':15s}" for rn in order)
+            ratio = lambda x, y: f"{row[x] / row[y]:.2f}" if row.get(x) and row.get(y) else "n/a"
+            print(f"{row['scene']:8s} {row['seconds']:8.2f}{cells} {ratio('veach-gpu', 'mitsuba-llvm'):>11s}"
+                  f" {ratio('veach-cpu', 'mitsuba-scalar'):>13s}")
+    return out
 
 
 def main():
@@ -423,12 +512,15 @@ def main():
     b.add_argument("--seed", type=int, default=7)
     b.add_argument("--repeat", type=int, default=1)
     b.add_argument("--exr-dir")
+    b.add_argument("--ref-dir", help="shared scenes dir: record a convergence series against its reference")
+    b.add_argument("--series-seconds", type=float, default=0.0, help="extend the series to this render time")
     b.add_argument("--out", required=True)
     r = sub.add_parser("report")
     r.add_argument("--mitsuba", required=True)
     r.add_argument("--veach-runs", help="TSV: scene, renderer, stats JSON, image")
     r.add_argument("--json")
     r.add_argument("--ref-dir")
+    r.add_argument("--series-dir", help="write each convergence series here for veach plot-convergence")
     a = p.parse_args()
     if a.cmd == "bench":
         if a.repeat < 1:

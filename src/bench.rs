@@ -58,6 +58,8 @@ pub struct SceneResult {
     pub renders: Vec<RenderResult>,
     /// Traversal on the CPU reference's BVH walk (same nodes and order as the GPU's).
     pub rays: Vec<RayResult>,
+    /// Traversal in the GPU kernel (`shaders/trace.wgsl`), when the GPU backend was run.
+    pub gpu_rays: Vec<RayResult>,
 }
 
 #[derive(Clone, Debug, serde::Serialize)]
@@ -98,6 +100,7 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
             geometry_bytes_per_triangle: geometry as f64 / tris as f64,
             renders: Vec::new(),
             rays: Vec::new(),
+            gpu_rays: Vec::new(),
         };
         let settings =
             Settings { width: opts.width, height: opts.height, max_depth: opts.max_depth, ..Settings::default() };
@@ -121,6 +124,10 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
         progress(&format!("{name}: tracing ray batches"));
         let r = Renderer::new(packed, &camera, &settings, Backend::Cpu)?;
         result.rays = ray_throughput(r.scene(), r.params());
+        if let Some(ctx) = &ctx {
+            let mut g = gpu::GpuRenderer::new(ctx.clone(), r.scene(), *r.params())?;
+            result.gpu_rays = gpu_ray_throughput(&mut g)?;
+        }
         results.push(result);
     }
     Ok(BenchReport {
@@ -198,6 +205,31 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<Ra
     let _: Vec<_> = diffuse.par_iter().map(|r| intersect_closest(scene, r)).collect();
     let diffuse_result = time("diffuse", diffuse.len(), t.elapsed().as_secs_f64());
     vec![primary_result, shadow_result, diffuse_result]
+}
+
+/// The GPU twin of `ray_throughput`: the same three kinds of rays, generated in the kernel
+/// (`shaders/trace.wgsl`). Shadow and bounce rays are timed as the difference between the
+/// kernel that traces them after the primary ray and the one that traces the primary ray only.
+fn gpu_ray_throughput(g: &mut gpu::GpuRenderer) -> Result<Vec<RayResult>, Error> {
+    const PASSES: u32 = 16;
+    let result = |kind: &'static str, rays: f64, seconds: f64| RayResult {
+        kind,
+        rays: rays as usize,
+        seconds,
+        mrays_per_second: rays / seconds.max(1e-9) / 1e6,
+    };
+    let primary_seconds = g.trace_rays(0, PASSES)?;
+    let film = g.read_film()?;
+    // Each primary ray that hit something left a 1 and spawns one secondary ray.
+    let hits: f64 = (0..film.pixel_count()).map(|i| film.sum(i).x).sum();
+    let primary = film.pixel_count() as f64 * PASSES as f64;
+    let shadow_seconds = g.trace_rays(1, PASSES)? - primary_seconds;
+    let diffuse_seconds = g.trace_rays(2, PASSES)? - primary_seconds;
+    Ok(vec![
+        result("primary", primary, primary_seconds),
+        result("shadow", hits, shadow_seconds),
+        result("diffuse", hits, diffuse_seconds),
+    ])
 }
 
 fn machine_name() -> String {
@@ -359,10 +391,11 @@ pub fn format_report(r: &BenchReport) -> String {
             s += &format!("{head}  {:<8} {:>10.3} {:>9.2}\n", run.backend, run.msamples_per_second, run.seconds);
         }
     }
-    s += "\nBVH traversal on the CPU reference (M rays/s): primary / shadow / diffuse bounce\n";
+    let rates = |rays: &[RayResult]| rays.iter().map(|x| format!("{:.2}", x.mrays_per_second)).collect::<Vec<_>>();
+    s += "\nBVH traversal (M rays/s): primary / shadow / diffuse bounce\n";
+    s += &format!("{:<14} {:<24} {}\n", "scene", "CPU reference", "GPU kernel");
     for sc in &r.scenes {
-        let m: Vec<String> = sc.rays.iter().map(|x| format!("{:.2}", x.mrays_per_second)).collect();
-        s += &format!("{:<14} {}\n", sc.scene, m.join(" / "));
+        s += &format!("{:<14} {:<24} {}\n", sc.scene, rates(&sc.rays).join(" / "), rates(&sc.gpu_rays).join(" / "));
     }
     s
 }

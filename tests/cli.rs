@@ -333,3 +333,42 @@ fn reference_records_convergence_and_plots_it() {
     assert_user_error(&out, "cbox_d8_64.exr");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn bench_reports_renders_and_ray_rates_per_backend() {
+    // A smoke test of the benchmark's report (its numbers are timings and are not judged here).
+    let with_gpu = common::gpu("bench_reports_renders_and_ray_rates_per_backend").is_some();
+    let d = temp_dir("bench");
+    let json = d.join("bench.json");
+    let mut args =
+        vec!["bench", "--width", "16", "--height", "16", "--spp", "1", "--large-grid", "1", "--backend", "cpu"];
+    if with_gpu {
+        args.extend(["--backend", "gpu"]);
+    }
+    args.extend(["--json", json.to_str().expect("utf8")]);
+    let out = veach(&args, &[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).expect("json")).expect("valid json");
+    let scenes = report["scenes"].as_array().expect("scenes");
+    assert_eq!(scenes.len(), 3);
+    for sc in scenes {
+        assert_eq!(sc["renders"].as_array().expect("renders").len(), if with_gpu { 2 } else { 1 });
+        let kinds = |key: &str| -> Vec<(String, f64)> {
+            sc[key]
+                .as_array()
+                .expect("rays")
+                .iter()
+                .map(|r| (r["kind"].as_str().unwrap_or("").to_string(), r["rays"].as_f64().unwrap_or(0.0)))
+                .collect()
+        };
+        let cpu = kinds("rays");
+        assert_eq!(cpu.iter().map(|k| k.0.as_str()).collect::<Vec<_>>(), ["primary", "shadow", "diffuse"]);
+        if with_gpu {
+            let gpu = kinds("gpu_rays");
+            assert_eq!(gpu.len(), 3, "{sc}");
+            // 16 passes of 16×16 primary rays; one secondary ray per primary hit.
+            assert_eq!(gpu[0].1, 16.0 * 256.0);
+            assert!(gpu[1].1 > 0.0 && gpu[1].1 <= gpu[0].1 && gpu[1].1 == gpu[2].1, "{gpu:?}");
+        }
+    }
+}

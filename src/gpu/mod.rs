@@ -109,6 +109,11 @@ pub struct GpuRenderer {
     ctx: GpuContext,
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    variant: shaders::Geometry,
+    constants: [(&'static str, f64); 5],
+    /// `trace_rays` pipelines by TRACE_KIND, built on first use (by `veach bench` only).
+    trace_pipelines: [Option<wgpu::ComputePipeline>; 3],
     scene: [wgpu::Buffer; 6],
     /// Nodes, triangles and attributes as textures (bindings 1–3) when the scene is beyond a
     /// storage binding; `scene[0..3]` are then unused placeholders.
@@ -238,6 +243,7 @@ impl GpuRenderer {
             },
             cache: None,
         });
+        let constants = scene.features().constants();
         let (film_buf, readback, bind_group) =
             Self::film(&ctx, &layout, &scene_buffers, geometry.as_ref(), &textures, &params_buf, params)?;
         let paged_bytes = if paged { geometry_bytes.iter().map(|b| b.len() as u64).sum() } else { 0 };
@@ -249,6 +255,10 @@ impl GpuRenderer {
             ctx,
             pipeline,
             layout,
+            pipeline_layout,
+            variant,
+            constants,
+            trace_pipelines: [None, None, None],
             scene: scene_buffers,
             geometry,
             textures,
@@ -424,6 +434,47 @@ impl GpuRenderer {
 
     /// Renders sample indices `start .. start + count` (one dispatch each) and waits.
     pub fn render_samples(&mut self, start: u32, count: u32) -> Result<(), Error> {
+        self.dispatch_samples(None, start, count)
+    }
+
+    /// Traversal throughput (`shaders/trace.wgsl`): `passes` dispatches of the ray kernel of
+    /// kind `kind` (0 primary, 1 primary + shadow, 2 primary + diffuse bounce) into a cleared
+    /// film; returns the seconds they took (the pipeline is compiled before timing starts).
+    pub fn trace_rays(&mut self, kind: u32, passes: u32) -> Result<f64, Error> {
+        let k = kind.min(2) as usize;
+        if self.trace_pipelines[k].is_none() {
+            let source = shaders::compose_with(shaders::TRACE, self.variant).map_err(Error::Gpu)?;
+            let module = self.ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("trace"),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+            let mut constants = self.constants.to_vec();
+            constants.push(("TRACE_KIND", k as f64));
+            let pipeline = self.ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("trace"),
+                layout: Some(&self.pipeline_layout),
+                module: &module,
+                entry_point: Some("trace_rays"),
+                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+                cache: None,
+            });
+            self.trace_pipelines[k] = Some(pipeline);
+            // Lavapipe compiles at first dispatch: one untimed pass.
+            self.dispatch_samples(Some(k), 0, 1)?;
+            self.ctx.check()?;
+        }
+        self.reset(self.params)?;
+        let t = std::time::Instant::now();
+        self.dispatch_samples(Some(k), 0, passes)?;
+        Ok(t.elapsed().as_secs_f64())
+    }
+
+    /// `count` dispatches from sample index `start`, of the integrator or of a trace kernel.
+    fn dispatch_samples(&self, trace: Option<usize>, start: u32, count: u32) -> Result<(), Error> {
+        let pipeline = match trace {
+            Some(k) => self.trace_pipelines[k].as_ref().ok_or_else(|| Error::Gpu("no trace pipeline".into()))?,
+            None => &self.pipeline,
+        };
         let mut done = 0;
         while done < count {
             let batch = (count - done).min(MAX_BATCH);
@@ -437,7 +488,7 @@ impl GpuRenderer {
             let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
             {
                 let mut pass = encoder.begin_compute_pass(&Default::default());
-                pass.set_pipeline(&self.pipeline);
+                pass.set_pipeline(pipeline);
                 for k in 0..batch {
                     pass.set_bind_group(0, &self.bind_group, &[(self.stride * k as u64) as u32]);
                     pass.dispatch_workgroups(

@@ -23,12 +23,15 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
     ("film.wgsl", include_str!("../../shaders/film.wgsl")),
     ("integrator.wgsl", include_str!("../../shaders/integrator.wgsl")),
+    ("trace.wgsl", include_str!("../../shaders/trace.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
     ("display.wgsl", include_str!("../../shaders/display.wgsl")),
 ];
 
 /// The kernels' entry files.
 pub const INTEGRATOR: &str = "integrator.wgsl";
+/// The ray-throughput kernel of `veach bench` (entry point `trace_rays`).
+pub const TRACE: &str = "trace.wgsl";
 pub const DISPLAY: &str = "display.wgsl";
 
 /// Where the kernel reads scene geometry from: `#include "geometry.wgsl"` resolves to one of

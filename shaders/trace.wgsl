@@ -1,0 +1,41 @@
+// Ray-throughput kernel for `veach bench`: traversal alone, without shading. TRACE_KIND 0
+// traces a primary ray per pixel; 1 adds a shadow ray from its hit to a light sample; 2 adds a
+// cosine-distributed bounce ray from its hit. The host times the three and takes differences,
+// as the CPU twin (src/bench.rs, ray_throughput) times batches of the same kinds of rays.
+// Each pixel adds (primary hit + secondary hit or unblocked) to the film, so that no trace
+// is dead code and the host can count the secondary rays.
+#include "integrator.wgsl"
+
+override TRACE_KIND: u32 = 0u;
+
+@compute @workgroup_size(8, 8, 1)
+fn trace_rays(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let row = gid.y + params.row_offset;
+    if (gid.x >= params.film_width || row >= params.film_height) {
+        return;
+    }
+    let pixel = vec2<u32>(gid.x + params.tile_x, row + params.tile_y);
+    var sampler = sampler_init(params.sampler, pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
+    let ray = generate_ray(pixel, sample_2d(&sampler), &sampler);
+    let hit = intersect_closest(ray);
+    var count = 0.0;
+    if (hit.tri != NO_HIT) {
+        count = 1.0;
+        let tri = world_triangle(hit.tri, hit.instance);
+        let n = normalize(cross(tri.e1, tri.e2));
+        let ng = select(n, -n, dot(n, ray.dir) > 0.0);
+        let point = tri.p0 + hit.u * tri.e1 + hit.v * tri.e2;
+        if (TRACE_KIND == 1u && (params.light_count > 0u || params.env_select > 0.0)) {
+            let ls = sample_light(point, vec3<f32>(sample_1d(&sampler), sample_2d(&sampler)));
+            if (ls.pdf > 0.0 && unoccluded(offset_ray(point, ng), ls)) {
+                count += 1.0;
+            }
+        } else if (TRACE_KIND == 2u) {
+            let wi = from_local(frame_from_normal(ng), sample_cosine_hemisphere(sample_2d(&sampler)));
+            if (intersect_closest(Ray(offset_ray(point, ng), wi)).tri != NO_HIT) {
+                count += 1.0;
+            }
+        }
+    }
+    film_add_sample(row * params.film_width + gid.x, vec3<f32>(count));
+}
