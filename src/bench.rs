@@ -60,6 +60,10 @@ pub struct SceneResult {
     pub rays: Vec<RayResult>,
     /// Traversal in the GPU kernel (`shaders/trace.wgsl`), when the GPU backend was run.
     pub gpu_rays: Vec<RayResult>,
+    /// The same rays on the CPU through obvhs's compressed 8-wide BVH (Ylitie et al. 2017)
+    /// and its own traversal, for comparison with our BVH2 layout (scenes without instances).
+    pub cwbvh_rays: Vec<RayResult>,
+    pub cwbvh_build_seconds: f64,
 }
 
 #[derive(Clone, Debug, serde::Serialize)]
@@ -101,6 +105,8 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
             renders: Vec::new(),
             rays: Vec::new(),
             gpu_rays: Vec::new(),
+            cwbvh_rays: Vec::new(),
+            cwbvh_build_seconds: 0.0,
         };
         let settings =
             Settings { width: opts.width, height: opts.height, max_depth: opts.max_depth, ..Settings::default() };
@@ -123,7 +129,11 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
         }
         progress(&format!("{name}: tracing ray batches"));
         let r = Renderer::new(packed, &camera, &settings, Backend::Cpu)?;
-        result.rays = ray_throughput(r.scene(), r.params());
+        let (rays, batches) = ray_throughput(r.scene(), r.params());
+        result.rays = rays;
+        if r.scene().instance_count == 0 {
+            (result.cwbvh_rays, result.cwbvh_build_seconds) = cwbvh_ray_throughput(r.scene(), &batches);
+        }
         if let Some(ctx) = &ctx {
             let mut g = gpu::GpuRenderer::new(ctx.clone(), r.scene(), *r.params())?;
             result.gpu_rays = gpu_ray_throughput(&mut g)?;
@@ -140,7 +150,7 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
 
 /// Primary rays through every pixel; shadow rays from their hits to a point on a light
 /// (or straight up when the scene has none); cosine-distributed bounce rays from the hits.
-fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<RayResult> {
+fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> (Vec<RayResult>, [Vec<Ray>; 3]) {
     let (w, h) = (params.image_width, params.image_height);
     let time = |kind: &'static str, n: usize, seconds: f64| RayResult {
         kind,
@@ -216,7 +226,91 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<Ra
             std::hint::black_box(diffuse.par_iter().map(|r| intersect_closest(scene, r).t).sum::<f32>());
         }),
     );
-    vec![primary_result, shadow_result, diffuse_result]
+    (vec![primary_result, shadow_result, diffuse_result], [primary, shadow, diffuse])
+}
+
+/// The batches of `ray_throughput` through obvhs's CWBVH (built from the same triangles with
+/// the same build settings) and its traversal, with our triangle test.
+fn cwbvh_ray_throughput(scene: &PackedScene, batches: &[Vec<Ray>; 3]) -> (Vec<RayResult>, f64) {
+    use obvhs::ray::{Ray as ORay, RayHit};
+    let tris: Vec<obvhs::triangle::Triangle> = scene
+        .triangles
+        .iter()
+        .map(|t| {
+            let (p0, e1, e2) = (Vec3::from(t.p0), Vec3::from(t.e1), Vec3::from(t.e2));
+            obvhs::triangle::Triangle { v0: p0.into(), v1: (p0 + e1).into(), v2: (p0 + e2).into() }
+        })
+        .collect();
+    let t = Instant::now();
+    let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
+        &tris,
+        obvhs::BvhBuildParams::medium_build(),
+        &mut std::time::Duration::default(),
+    );
+    let build_seconds = t.elapsed().as_secs_f64();
+    let intersect = |ray: &ORay, id: usize| {
+        let tri = &scene.triangles[bvh.primitive_indices[id] as usize];
+        let r = crate::cpu::bvh::intersect_triangle(&Ray { origin: ray.origin.into(), dir: ray.direction.into() }, tri);
+        if r.x >= crate::cpu::bvh::INF { f32::INFINITY } else { r.x }
+    };
+    let closest = |rays: &[Ray]| {
+        rays.par_iter()
+            .map(|r| {
+                let mut hit = RayHit::none();
+                bvh.ray_traverse(ORay::new_inf(r.origin.into(), r.dir.into()), &mut hit, intersect);
+                hit.t.min(1e30)
+            })
+            .sum::<f32>()
+    };
+    let result = |kind: &'static str, rays: &[Ray], seconds: f64| RayResult {
+        kind,
+        rays: rays.len(),
+        seconds,
+        mrays_per_second: rays.len() as f64 / seconds.max(1e-9) / 1e6,
+    };
+    let [primary, shadow, diffuse] = batches;
+    // The comparison is only meaningful if both walks find the same hits.
+    for rays in [primary, diffuse] {
+        let differ = rays
+            .par_iter()
+            .filter(|r| {
+                let mut hit = RayHit::none();
+                bvh.ray_traverse(ORay::new_inf(r.origin.into(), r.dir.into()), &mut hit, intersect);
+                let ours = intersect_closest(scene, r);
+                let ours = if ours.tri == crate::cpu::bvh::NO_HIT { f32::INFINITY } else { ours.t };
+                ours != hit.t && (ours - hit.t).abs() > 1e-4 * ours.abs().max(1.0)
+            })
+            .count();
+        assert!(differ * 1000 <= rays.len(), "obvhs's CWBVH and our BVH2 disagree on {differ} of {} rays", rays.len());
+    }
+    let rates = vec![
+        result(
+            "primary",
+            primary,
+            best_of(|| {
+                std::hint::black_box(closest(primary));
+            }),
+        ),
+        result(
+            "shadow",
+            shadow,
+            best_of(|| {
+                let blocked = shadow
+                    .par_iter()
+                    .filter(|r| !bvh.ray_traverse_miss(ORay::new(r.origin.into(), r.dir.into(), 0.0, 0.999), intersect))
+                    .count();
+                std::hint::black_box(blocked);
+            }),
+        ),
+        result(
+            "diffuse",
+            diffuse,
+            best_of(|| {
+                std::hint::black_box(closest(diffuse));
+            }),
+        ),
+    ];
+    (rates, build_seconds)
 }
 
 /// Seconds of one run of `f`: the fastest of at least 5 runs and 0.3 s (a batch of ~65k rays
@@ -429,9 +523,16 @@ pub fn format_report(r: &BenchReport) -> String {
     }
     let rates = |rays: &[RayResult]| rays.iter().map(|x| format!("{:.2}", x.mrays_per_second)).collect::<Vec<_>>();
     s += "\nBVH traversal (M rays/s): primary / shadow / diffuse bounce\n";
-    s += &format!("{:<14} {:<24} {}\n", "scene", "CPU reference", "GPU kernel");
+    s +=
+        &format!("{:<14} {:<24} {:<24} {}\n", "scene", "CPU reference (BVH2)", "GPU kernel (BVH2)", "CPU, obvhs CWBVH");
     for sc in &r.scenes {
-        s += &format!("{:<14} {:<24} {}\n", sc.scene, rates(&sc.rays).join(" / "), rates(&sc.gpu_rays).join(" / "));
+        s += &format!(
+            "{:<14} {:<24} {:<24} {}\n",
+            sc.scene,
+            rates(&sc.rays).join(" / "),
+            rates(&sc.gpu_rays).join(" / "),
+            rates(&sc.cwbvh_rays).join(" / ")
+        );
     }
     s
 }
