@@ -71,6 +71,12 @@ fn sample_ranges_and_tiles_merge_into_the_same_bytes() {
     let again = veach(&["merge", s(&d.join("a.exr")), s(&d.join("a.exr")), "-o", s(&d.join("x.exr"))]);
     assert_eq!(again.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&again.stderr).contains("overlap"));
+    // So are parts made with another sample generator: the merged file could not say how it
+    // was made, nor be resumed.
+    render(&d.join("c.exr"), &["--sample-range", "5..12", "--sampler", "independent"]);
+    let mixed = veach(&["merge", s(&d.join("a.exr")), s(&d.join("c.exr")), "-o", s(&d.join("y.exr"))]);
+    assert_eq!(mixed.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&mixed.stderr).contains("sampler"));
     let _ = std::fs::remove_dir_all(&d);
 }
 
