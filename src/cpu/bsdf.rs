@@ -17,12 +17,14 @@ pub struct BsdfSample {
     pub delta: bool,
 }
 
+#[inline]
 pub fn fresnel_schlick(f0: Vec3, f90: Vec3, cos_theta: f32) -> Vec3 {
     let m = (1.0 - cos_theta).clamp(0.0, 1.0);
     let m2 = m * m;
     f0 + (f90 - f0) * (m2 * m2 * m)
 }
 
+#[inline]
 pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     let c = cos_i.clamp(0.0, 1.0);
     let sin2_t = (1.0 - c * c) / (eta * eta);
@@ -35,6 +37,7 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     0.5 * (r_parl * r_parl + r_perp * r_perp)
 }
 
+#[inline]
 pub fn dielectric_fresnel(m: &PackedMaterial, cos_theta: f32, eta: f32) -> Vec3 {
     if m.transmission > 0.0 {
         return Vec3::splat(fresnel_dielectric(cos_theta, eta));
@@ -42,21 +45,25 @@ pub fn dielectric_fresnel(m: &PackedMaterial, cos_theta: f32, eta: f32) -> Vec3 
     fresnel_schlick(m.dielectric_f0.into(), Vec3::splat(m.dielectric_f90), cos_theta)
 }
 
+#[inline]
 pub fn bsdf_fresnel(m: &PackedMaterial, cos_theta: f32, eta: f32) -> Vec3 {
     let metal = fresnel_schlick(m.base_color.into(), Vec3::ONE, cos_theta);
     dielectric_fresnel(m, cos_theta, eta).lerp(metal, m.metallic)
 }
 
+#[inline]
 pub fn diffuse_albedo(m: &PackedMaterial, cos_o: f32, eta: f32) -> Vec3 {
     let f = dielectric_fresnel(m, cos_o, eta);
     (1.0 - m.metallic) * (1.0 - m.transmission) * Vec3::from(m.base_color) * (Vec3::ONE - f)
 }
 
+#[inline]
 pub fn transmission_albedo(m: &PackedMaterial, cos_o: f32, eta: f32) -> Vec3 {
     let f = dielectric_fresnel(m, cos_o, eta);
     (1.0 - m.metallic) * m.transmission * Vec3::from(m.base_color) * (Vec3::ONE - f)
 }
 
+#[inline]
 pub fn lobe_probabilities(m: &PackedMaterial, cos_o: f32, eta: f32) -> Vec3 {
     let mut wt = luminance(transmission_albedo(m, cos_o, eta));
     if m.roughness * m.roughness >= DELTA_ALPHA {
