@@ -17,6 +17,8 @@
 #                       Russian roulette after 3 segments, so 3 makes the integrators match)
 #   --variants LIST     Mitsuba variants (default llvm_ad_rgb,scalar_rgb; "" = no Mitsuba)
 #   --backends LIST     veach backends (default gpu,cpu; "" = no veach)
+#   --veach-sampler S   veach's --sampler (default sobol, veach's default; Mitsuba runs its
+#                       independent sampler, so "independent" compares equal work per sample)
 #   --rmse              write every image as EXR (Mitsuba: mi.util.write_bitmap) and print the
 #                       image means and RMSE against mitsuba-llvm and, where one fits the
 #                       settings, against the shared reference render; where a reference fits
@@ -52,6 +54,7 @@ repeat=1
 rr_depth=5
 variants="llvm_ad_rgb,scalar_rgb"
 backends="gpu,cpu"
+veach_sampler=sobol
 rmse=0
 out_dir=""
 json_out=""
@@ -71,6 +74,7 @@ while [[ $# -gt 0 ]]; do
     --mitsuba-rr-depth) need_arg "$@"; rr_depth=$2; shift 2 ;;
     --variants) need_arg "$@"; variants=$2; shift 2 ;;
     --backends) need_arg "$@"; backends=$2; shift 2 ;;
+    --veach-sampler) need_arg "$@"; veach_sampler=$2; shift 2 ;;
     --rmse) rmse=1; shift ;;
     --out-dir) need_arg "$@"; out_dir=$2; shift 2 ;;
     --json) need_arg "$@"; json_out=$2; shift 2 ;;
@@ -159,7 +163,7 @@ echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo 2>/dev/null
 if awk -v l="$load" 'BEGIN { exit !(l > 0.5) }'; then
   echo "warning: load average $load: something else is running; the numbers will be low and noisy" >&2
 fi
-echo "settings: ${size}x${size}, $spp spp, max depth $depth, seed $seed, $repeat timed run(s); scenes ${scene_list[*]} from $scenes_dir" >&2
+echo "settings: ${size}x${size}, $spp spp, max depth $depth, seed $seed, veach sampler $veach_sampler, $repeat timed run(s); scenes ${scene_list[*]} from $scenes_dir" >&2
 
 # The shared reference render that fits a scene at these settings (as reference_for in
 # mitsuba_scenes.py), or nothing.
@@ -193,7 +197,8 @@ if [[ ${#backend_list[@]} -gt 0 ]]; then
         ref=$(reference_for "$s")
         [[ $rmse == 1 && -n $ref ]] && ref_args=(--reference "$ref")
         if ! "$veach_bin" render "$scenes_dir/$s.gltf" --backend "$b" --width "$size" --height "$size" \
-            --spp "$spp" --max-depth "$depth" --seed "$seed" --stats-json "$stats" -o "$img" "${ref_args[@]}" \
+            --spp "$spp" --max-depth "$depth" --seed "$seed" --sampler "$veach_sampler" --stats-json "$stats" \
+            -o "$img" "${ref_args[@]}" \
             > "$out_dir/veach.log" 2>&1; then
           cat "$out_dir/veach.log" >&2
           die "veach render failed: $s, backend $b"
