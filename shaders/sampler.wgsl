@@ -27,28 +27,33 @@ fn sampler_init(kind: u32, pixel: u32, sample_index: u32, seed: u32) -> Sampler 
 }
 
 // A random permutation of [0, 2^32) in which bit k of the output depends only on bits k and
-// above of the input: Owen scrambling of the bit-reversed value (Laine–Karras style hash with
-// Burley's constants).
-fn owen_scramble(v: u32, seed: u32) -> u32 {
-    var x = reverseBits(v);
+// below of the input (a Laine–Karras style hash with Burley's constants). Between two bit
+// reversals it is an Owen scramble: bit k then depends on bits k and above.
+fn laine_karras(v: u32, seed: u32) -> u32 {
+    var x = v;
     x ^= x * 0x3d20adeau;
     x += seed;
     x *= (seed >> 16u) | 1u;
     x ^= x * 0x05526c56u;
     x ^= x * 0x53a22864u;
-    return reverseBits(x);
+    return x;
 }
 
-// Sobol' dimension 1 from dimension 0 (the bit reversal of the index): its generator matrix is
-// Pascal's triangle mod 2, a Kronecker power of [[1, 1], [0, 1]], applied in five butterfly steps
-// instead of a loop over the index bits (tests/sampler.rs checks it against the direction numbers).
-fn sobol_1_from_0(x: u32) -> u32 {
-    var y = x;
-    y ^= (y << 1u) & 0xaaaaaaaau;
-    y ^= (y << 2u) & 0xccccccccu;
-    y ^= (y << 4u) & 0xf0f0f0f0u;
-    y ^= (y << 8u) & 0xff00ff00u;
-    y ^= (y << 16u) & 0xffff0000u;
+fn owen_scramble(v: u32, seed: u32) -> u32 {
+    return reverseBits(laine_karras(reverseBits(v), seed));
+}
+
+// Sobol' dimension 1 of `index`, bit-reversed (dimension 0 is the bit reversal itself, so in
+// this domain the index is dimension 0). Its generator matrix is Pascal's triangle mod 2, a
+// Kronecker power of [[1, 1], [0, 1]], applied in five butterfly steps instead of a loop over
+// the index bits (tests/sampler.rs checks it against the direction numbers).
+fn sobol_1_reversed(index: u32) -> u32 {
+    var y = index;
+    y ^= (y >> 1u) & 0x55555555u;
+    y ^= (y >> 2u) & 0x33333333u;
+    y ^= (y >> 4u) & 0x0f0f0f0fu;
+    y ^= (y >> 8u) & 0x00ff00ffu;
+    y ^= (y >> 16u) & 0x0000ffffu;
     return y;
 }
 
@@ -71,9 +76,11 @@ fn sample_1d(s: ptr<function, Sampler>) -> f32 {
         (*s).state = state;
         return a;
     }
+    // Owen-scrambled Sobol' dimension 0 at a shuffled index: owen_scramble(reverseBits(i), ..)
+    // with the reversals that cancel left out.
     let d = next_dimension_seed(s);
     let i = owen_scramble((*s).index, d);
-    return unit_float(owen_scramble(reverseBits(i), pcg_hash(d ^ 1u)));
+    return unit_float(reverseBits(laine_karras(i, pcg_hash(d ^ 1u))));
 }
 
 fn sample_2d(s: ptr<function, Sampler>) -> vec2<f32> {
@@ -84,10 +91,11 @@ fn sample_2d(s: ptr<function, Sampler>) -> vec2<f32> {
         (*s).state = state;
         return vec2<f32>(a, b);
     }
+    // Dimensions 0 and 1 at a shuffled index, each Owen-scrambled; working on reversed values
+    // saves the reversals that would cancel.
     let d = next_dimension_seed(s);
     let i = owen_scramble((*s).index, d);
-    let sobol_0 = reverseBits(i);
-    let x = owen_scramble(sobol_0, pcg_hash(d ^ 1u));
-    let y = owen_scramble(sobol_1_from_0(sobol_0), pcg_hash(d ^ 2u));
+    let x = reverseBits(laine_karras(i, pcg_hash(d ^ 1u)));
+    let y = reverseBits(laine_karras(sobol_1_reversed(i), pcg_hash(d ^ 2u)));
     return vec2<f32>(unit_float(x), unit_float(y));
 }

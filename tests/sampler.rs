@@ -6,7 +6,7 @@ mod common;
 
 use common::*;
 use veach::SamplerKind;
-use veach::cpu::sampler::{SAMPLER_SOBOL, Sampler, sample_1d, sample_2d, sampler_init, sobol_1_from_0};
+use veach::cpu::sampler::{SAMPLER_SOBOL, Sampler, sample_1d, sample_2d, sampler_init, sobol_1_reversed};
 
 /// Sobol' dimension 1 straight from its direction numbers v_1 = 2^31, v_k = v_(k-1) ^ (v_(k-1) >> 1).
 fn sobol_1_by_direction_numbers(index: u32) -> u32 {
@@ -29,7 +29,7 @@ fn sobol_dimension_1_matches_its_direction_numbers() {
         x ^= x << 5;
         x
     })) {
-        assert_eq!(sobol_1_from_0(i.reverse_bits()), sobol_1_by_direction_numbers(i), "index {i}");
+        assert_eq!(sobol_1_reversed(i).reverse_bits(), sobol_1_by_direction_numbers(i), "index {i}");
     }
 }
 

@@ -20,23 +20,27 @@ pub fn sampler_init(kind: u32, pixel: u32, sample_index: u32, seed: u32) -> Samp
     Sampler { kind, pixel_seed, index: sample_index, dim: 0, state: rng_init(pixel, sample_index, seed) }
 }
 
-pub fn owen_scramble(v: u32, seed: u32) -> u32 {
-    let mut x = v.reverse_bits();
+pub fn laine_karras(v: u32, seed: u32) -> u32 {
+    let mut x = v;
     x ^= x.wrapping_mul(0x3d20adea);
     x = x.wrapping_add(seed);
     x = x.wrapping_mul((seed >> 16) | 1);
     x ^= x.wrapping_mul(0x05526c56);
     x ^= x.wrapping_mul(0x53a22864);
-    x.reverse_bits()
+    x
 }
 
-pub fn sobol_1_from_0(x: u32) -> u32 {
-    let mut y = x;
-    y ^= (y << 1) & 0xaaaa_aaaa;
-    y ^= (y << 2) & 0xcccc_cccc;
-    y ^= (y << 4) & 0xf0f0_f0f0;
-    y ^= (y << 8) & 0xff00_ff00;
-    y ^= (y << 16) & 0xffff_0000;
+pub fn owen_scramble(v: u32, seed: u32) -> u32 {
+    laine_karras(v.reverse_bits(), seed).reverse_bits()
+}
+
+pub fn sobol_1_reversed(index: u32) -> u32 {
+    let mut y = index;
+    y ^= (y >> 1) & 0x5555_5555;
+    y ^= (y >> 2) & 0x3333_3333;
+    y ^= (y >> 4) & 0x0f0f_0f0f;
+    y ^= (y >> 8) & 0x00ff_00ff;
+    y ^= (y >> 16) & 0x0000_ffff;
     y
 }
 
@@ -56,7 +60,7 @@ pub fn sample_1d(s: &mut Sampler) -> f32 {
     }
     let d = next_dimension_seed(s);
     let i = owen_scramble(s.index, d);
-    unit_float(owen_scramble(i.reverse_bits(), pcg_hash(d ^ 1)))
+    unit_float(laine_karras(i, pcg_hash(d ^ 1)).reverse_bits())
 }
 
 pub fn sample_2d(s: &mut Sampler) -> Vec2 {
@@ -67,8 +71,7 @@ pub fn sample_2d(s: &mut Sampler) -> Vec2 {
     }
     let d = next_dimension_seed(s);
     let i = owen_scramble(s.index, d);
-    let sobol_0 = i.reverse_bits();
-    let x = owen_scramble(sobol_0, pcg_hash(d ^ 1));
-    let y = owen_scramble(sobol_1_from_0(sobol_0), pcg_hash(d ^ 2));
+    let x = laine_karras(i, pcg_hash(d ^ 1)).reverse_bits();
+    let y = laine_karras(sobol_1_reversed(i), pcg_hash(d ^ 2)).reverse_bits();
     Vec2::new(unit_float(x), unit_float(y))
 }
