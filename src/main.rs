@@ -646,6 +646,11 @@ fn view(args: ViewArgs) -> Result<(), Error> {
     })
 }
 
+/// What parts of one render must share to be merged.
+fn settings_key(j: &Job) -> (u32, u32, u32, u32, Strategy, SamplerKind, &Path, Option<&str>) {
+    (j.width, j.height, j.seed, j.max_depth, j.strategy, j.sampler, &j.scene, j.camera.as_deref())
+}
+
 fn merge(args: &MergeArgs) -> Result<Outcome, Error> {
     veach::output::check_output(&args.output)?;
     let mut parts = Vec::new();
@@ -659,17 +664,7 @@ fn merge(args: &MergeArgs) -> Result<Outcome, Error> {
     let mut merged = Film::new(job.width, job.height);
     let mut seen: Vec<(Tile, u32, u32, &Path)> = Vec::new();
     for ((film, part), path) in parts.iter().zip(&args.parts) {
-        let same =
-            (
-                part.width,
-                part.height,
-                part.seed,
-                part.max_depth,
-                part.strategy,
-                part.sampler,
-                &part.scene,
-                &part.camera,
-            ) == (job.width, job.height, job.seed, job.max_depth, job.strategy, job.sampler, &job.scene, &job.camera);
+        let same = settings_key(part) == settings_key(&job);
         if !same {
             return Err(Error::Input(format!(
                 "{}: rendered with other settings than {} (scene, size, seed, depth, strategy, sampler and camera must match)",
