@@ -17,3 +17,10 @@ fn generate_ray(pixel: vec2<u32>, u: vec2<f32>, sampler: ptr<function, Sampler>)
     let origin = params.cam_position + lens.x * normalize(params.cam_right) + lens.y * normalize(params.cam_up);
     return Ray(origin, normalize(focus - origin));
 }
+
+// The camera ray of `pixel` for sample params.sample_index, with the sampler its path goes on
+// drawing from.
+fn camera_sample(pixel: vec2<u32>, sampler: ptr<function, Sampler>) -> Ray {
+    *sampler = sampler_init(params.sampler, pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
+    return generate_ray(pixel, sample_2d(sampler), sampler);
+}

@@ -162,7 +162,7 @@ fn render_sample(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let pixel = vec2<u32>(gid.x + params.tile_x, row + params.tile_y);
-    var sampler = sampler_init(params.sampler, pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
-    let ray = generate_ray(pixel, sample_2d(&sampler), &sampler);
+    var sampler: Sampler;
+    let ray = camera_sample(pixel, &sampler);
     film_add_sample(row * params.film_width + gid.x, li(ray, &sampler));
 }

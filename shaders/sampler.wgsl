@@ -22,8 +22,10 @@ struct Sampler {
 }
 
 fn sampler_init(kind: u32, pixel: u32, sample_index: u32, seed: u32) -> Sampler {
-    let pixel_seed = pcg_hash(pixel ^ pcg_hash(seed ^ 0x5bd1e995u));
-    return Sampler(kind, pixel_seed, sample_index, 0u, rng_init(pixel, sample_index, seed));
+    if (kind == SAMPLER_INDEPENDENT) {
+        return Sampler(kind, 0u, sample_index, 0u, rng_init(pixel, sample_index, seed));
+    }
+    return Sampler(kind, pcg_hash(pixel ^ pcg_hash(seed ^ 0x5bd1e995u)), sample_index, 0u, 0u);
 }
 
 // A random permutation of [0, 2^32) in which bit k of the output depends only on bits k and

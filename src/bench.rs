@@ -5,7 +5,6 @@
 use crate::cpu::bvh::{Ray, intersect_closest, occluded, offset_ray};
 use crate::cpu::frame::{frame_from_normal, from_local};
 use crate::cpu::rng::{rng_init, rng_next2};
-use crate::cpu::sampler::{sample_2d, sampler_init};
 use crate::cpu::sampling::{sample_cosine_hemisphere, sample_uniform_triangle};
 use crate::packed::PackedScene;
 use crate::{Backend, Error, Renderer, Settings, gpu};
@@ -41,6 +40,12 @@ pub struct RayResult {
     pub rays: usize,
     pub seconds: f64,
     pub mrays_per_second: f64,
+}
+
+impl RayResult {
+    fn new(kind: &'static str, rays: usize, seconds: f64) -> RayResult {
+        RayResult { kind, rays, seconds, mrays_per_second: rays as f64 / seconds.max(1e-9) / 1e6 }
+    }
 }
 
 #[derive(Clone, Debug, serde::Serialize)]
@@ -155,22 +160,11 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
 /// (or straight up when the scene has none); cosine-distributed bounce rays from the hits.
 fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> (Vec<RayResult>, [Vec<Ray>; 3]) {
     let (w, h) = (params.image_width, params.image_height);
-    let time = |kind: &'static str, n: usize, seconds: f64| RayResult {
-        kind,
-        rays: n,
-        seconds,
-        mrays_per_second: n as f64 / seconds.max(1e-9) / 1e6,
-    };
-    let primary: Vec<Ray> = (0..w * h)
-        .map(|i| {
-            let mut sampler = sampler_init(params.sampler, i, 0, 1);
-            let pixel = glam::UVec2::new(i % w, i / w);
-            let jitter = sample_2d(&mut sampler);
-            crate::cpu::camera::generate_ray(params, pixel, jitter, &mut sampler)
-        })
-        .collect();
+    let first = crate::params::Params { sample_index: 0, seed: 1, ..*params };
+    let primary: Vec<Ray> =
+        (0..w * h).map(|i| crate::cpu::camera::camera_sample(&first, glam::UVec2::new(i % w, i / w)).0).collect();
     let hits: Vec<_> = primary.par_iter().map(|r| intersect_closest(scene, r)).collect();
-    let primary_result = time(
+    let primary_result = RayResult::new(
         "primary",
         primary.len(),
         best_of(|| {
@@ -207,7 +201,7 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> (Vec<R
             }
         })
         .collect();
-    let shadow_result = time(
+    let shadow_result = RayResult::new(
         "shadow",
         shadow.len(),
         best_of(|| {
@@ -222,7 +216,7 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> (Vec<R
             Ray { origin: p, dir: from_local(&frame_from_normal(n), sample_cosine_hemisphere(rng_next2(&mut rng))) }
         })
         .collect();
-    let diffuse_result = time(
+    let diffuse_result = RayResult::new(
         "diffuse",
         diffuse.len(),
         best_of(|| {
@@ -266,12 +260,7 @@ fn cwbvh_ray_throughput(scene: &PackedScene, batches: &[Vec<Ray>; 3]) -> Result<
             })
             .sum::<f32>()
     };
-    let result = |kind: &'static str, rays: &[Ray], seconds: f64| RayResult {
-        kind,
-        rays: rays.len(),
-        seconds,
-        mrays_per_second: rays.len() as f64 / seconds.max(1e-9) / 1e6,
-    };
+    let result = |kind: &'static str, rays: &[Ray], seconds: f64| RayResult::new(kind, rays.len(), seconds);
     let [primary, shadow, diffuse] = batches;
     // The comparison is only meaningful if both walks find the same hits.
     for rays in [primary, diffuse] {
@@ -339,32 +328,26 @@ fn best_of(mut f: impl FnMut()) -> f64 {
 /// kernel that traces them after the primary ray and the one that traces the primary ray only.
 fn gpu_ray_throughput(g: &mut gpu::GpuRenderer) -> Result<Vec<RayResult>, Error> {
     const PASSES: u32 = 16;
-    let result = |kind: &'static str, rays: f64, seconds: f64| RayResult {
-        kind,
-        rays: rays as usize,
-        seconds,
-        mrays_per_second: rays / seconds.max(1e-9) / 1e6,
-    };
     // Fastest of three runs of each kernel, as for the CPU batches.
-    let mut best = |kind: u32| -> Result<f64, Error> {
+    let best = |g: &mut gpu::GpuRenderer, kind: u32| -> Result<f64, Error> {
         let mut t = f64::INFINITY;
         for _ in 0..3 {
             t = t.min(g.trace_rays(kind, PASSES)?);
         }
         Ok(t)
     };
-    let primary_seconds = best(0)?;
-    let shadow_seconds = best(1)? - primary_seconds;
-    let diffuse_seconds = best(2)? - primary_seconds;
-    g.trace_rays(0, PASSES)?;
+    let primary_seconds = best(g, 0)?;
+    // The film still holds the last primary-only run: each primary ray that hit something left
+    // a 1 there and spawns one secondary ray in the other kernels.
     let film = g.read_film()?;
-    // Each primary ray that hit something left a 1 and spawns one secondary ray.
-    let hits: f64 = (0..film.pixel_count()).map(|i| film.sum(i).x).sum();
-    let primary = film.pixel_count() as f64 * PASSES as f64;
+    let hits = (0..film.pixel_count()).map(|i| film.sum(i).x).sum::<f64>() as usize;
+    let primary = film.pixel_count() * PASSES as usize;
+    let shadow_seconds = best(g, 1)? - primary_seconds;
+    let diffuse_seconds = best(g, 2)? - primary_seconds;
     Ok(vec![
-        result("primary", primary, primary_seconds),
-        result("shadow", hits, shadow_seconds),
-        result("diffuse", hits, diffuse_seconds),
+        RayResult::new("primary", primary, primary_seconds),
+        RayResult::new("shadow", hits, shadow_seconds),
+        RayResult::new("diffuse", hits, diffuse_seconds),
     ])
 }
 

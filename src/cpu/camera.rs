@@ -1,7 +1,7 @@
 //! Twin of `shaders/camera.wgsl`.
 
 use super::bvh::Ray;
-use super::sampler::{Sampler, sample_2d};
+use super::sampler::{Sampler, sample_2d, sampler_init};
 use super::sampling::sample_uniform_disk;
 use crate::params::Params;
 use glam::{UVec2, Vec2, Vec3};
@@ -20,6 +20,15 @@ pub fn generate_ray(params: &Params, pixel: UVec2, u: Vec2, sampler: &mut Sample
     let lens = sample_uniform_disk(sample_2d(sampler)) * params.aperture;
     let origin = position + lens.x * right.normalize() + lens.y * up.normalize();
     Ray { origin, dir: (focus - origin).normalize() }
+}
+
+/// The camera ray of `pixel` for sample `params.sample_index`, with the sampler its path goes
+/// on drawing from.
+pub fn camera_sample(params: &Params, pixel: UVec2) -> (Ray, Sampler) {
+    let mut sampler =
+        sampler_init(params.sampler, pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
+    let jitter = sample_2d(&mut sampler);
+    (generate_ray(params, pixel, jitter, &mut sampler), sampler)
 }
 
 /// The distance in focus when only an aperture is given: what the image centre sees.

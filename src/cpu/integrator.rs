@@ -2,14 +2,14 @@
 
 use super::bsdf::{bsdf_eval, bsdf_pdf, bsdf_sample};
 use super::bvh::{INF, NO_HIT, Ray, intersect_closest, occluded, offset_ray};
-use super::camera::generate_ray;
+use super::camera::camera_sample;
 use super::environment::{environment_pdf, environment_radiance};
 use super::frame::{Frame, frame_from_normal, from_local, to_local};
 use super::instance::world_triangle;
 use super::lights::{LightSample, light_pdf, sample_light, sample_punctual};
 use super::material::{material_at, shading_normal, triangle_uv};
 use super::mis::mis_weight;
-use super::sampler::{Sampler, sample_1d, sample_2d, sampler_init};
+use super::sampler::{Sampler, sample_1d, sample_2d};
 use crate::Strategy;
 use crate::packed::{PackedMaterial, PackedScene, TRI_MIRRORED};
 use crate::params::Params;
@@ -169,9 +169,6 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
 /// Sample `params.sample_index` of one film pixel; returns the radiance (possibly non-finite).
 pub fn render_sample(scene: &PackedScene, params: &Params, x: u32, y: u32) -> Vec3 {
     let pixel = UVec2::new(x + params.tile_x, y + params.tile_y);
-    let mut sampler =
-        sampler_init(params.sampler, pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);
-    let jitter = sample_2d(&mut sampler);
-    let ray = generate_ray(params, pixel, jitter, &mut sampler);
+    let (ray, mut sampler) = camera_sample(params, pixel);
     li(scene, params, ray, &mut sampler)
 }

@@ -16,8 +16,16 @@ pub struct Sampler {
 }
 
 pub fn sampler_init(kind: u32, pixel: u32, sample_index: u32, seed: u32) -> Sampler {
-    let pixel_seed = pcg_hash(pixel ^ pcg_hash(seed ^ 0x5bd1e995));
-    Sampler { kind, pixel_seed, index: sample_index, dim: 0, state: rng_init(pixel, sample_index, seed) }
+    if kind == SAMPLER_INDEPENDENT {
+        return Sampler {
+            kind,
+            pixel_seed: 0,
+            index: sample_index,
+            dim: 0,
+            state: rng_init(pixel, sample_index, seed),
+        };
+    }
+    Sampler { kind, pixel_seed: pcg_hash(pixel ^ pcg_hash(seed ^ 0x5bd1e995)), index: sample_index, dim: 0, state: 0 }
 }
 
 pub fn laine_karras(v: u32, seed: u32) -> u32 {
