@@ -25,6 +25,19 @@ struct BvhNode {
     count: u32,
 }
 
+// Compressed 8-wide BVH node (src/packed.rs CwNode): three BvhNode slots, the last 16 bytes
+// padding, so loaders read five 16-byte words.
+struct CwNode {
+    // Grid origin p (f32 bits) and the cell exponents (bytes 0–2) | imask << 24.
+    w0: vec4<u32>,
+    // child_base, primitive_base, child_meta (eight bytes).
+    w1: vec4<u32>,
+    // Quantised child bounds: min (two words of four bytes), then max.
+    qx: vec4<u32>,
+    qy: vec4<u32>,
+    qz: vec4<u32>,
+}
+
 struct Triangle {
     p0: vec3<f32>,
     material: u32,

@@ -20,6 +20,17 @@ fn load_node(i: u32) -> BvhNode {
     return BvhNode(bitcast<vec3<f32>>(a.xyz), a.w, bitcast<vec3<f32>>(b.xyz), b.w);
 }
 
+fn load_cw_node(i: u32) -> CwNode {
+    let t = 6u * i;
+    return CwNode(
+        textureLoad(node_texels, page_coord(t), 0),
+        textureLoad(node_texels, page_coord(t + 1u), 0),
+        textureLoad(node_texels, page_coord(t + 2u), 0),
+        textureLoad(node_texels, page_coord(t + 3u), 0),
+        textureLoad(node_texels, page_coord(t + 4u), 0),
+    );
+}
+
 fn load_triangle(i: u32) -> Triangle {
     let a = textureLoad(triangle_texels, page_coord(3u * i), 0);
     let b = textureLoad(triangle_texels, page_coord(3u * i + 1u), 0);

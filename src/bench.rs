@@ -66,7 +66,7 @@ pub struct SceneResult {
     /// Traversal in the GPU kernel (`shaders/trace.wgsl`), when the GPU backend was run.
     pub gpu_rays: Vec<RayResult>,
     /// The same rays on the CPU through obvhs's compressed 8-wide BVH (Ylitie et al. 2017)
-    /// and its own traversal, for comparison with our BVH2 layout (scenes without instances).
+    /// and its own (SIMD) traversal, for comparison with our walk (scenes without instances).
     pub cwbvh_rays: Vec<RayResult>,
     pub cwbvh_build_seconds: f64,
 }
@@ -105,7 +105,7 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
             load_seconds,
             bvh_build_seconds: packed.bvh_build_seconds,
             pack_seconds,
-            bvh_nodes: packed.nodes.len(),
+            bvh_nodes: packed.bvh_nodes,
             geometry_bytes_per_triangle: geometry as f64 / tris as f64,
             renders: Vec::new(),
             rays: Vec::new(),
@@ -275,7 +275,7 @@ fn cwbvh_ray_throughput(scene: &PackedScene, batches: &[Vec<Ray>; 3]) -> Result<
             })
             .count();
         if differ * 1000 > rays.len() {
-            return Err(format!("obvhs's CWBVH and our BVH2 disagree on {differ} of {} rays", rays.len()));
+            return Err(format!("obvhs's CWBVH walk and ours disagree on {differ} of {} rays", rays.len()));
         }
     }
     let rates = vec![
@@ -512,8 +512,7 @@ pub fn format_report(r: &BenchReport) -> String {
     }
     let rates = |rays: &[RayResult]| rays.iter().map(|x| format!("{:.2}", x.mrays_per_second)).collect::<Vec<_>>();
     s += "\nBVH traversal (M rays/s): primary / shadow / diffuse bounce\n";
-    s +=
-        &format!("{:<14} {:<24} {:<24} {}\n", "scene", "CPU reference (BVH2)", "GPU kernel (BVH2)", "CPU, obvhs CWBVH");
+    s += &format!("{:<14} {:<24} {:<24} {}\n", "scene", "CPU reference", "GPU kernel", "CPU, obvhs's CWBVH walk");
     for sc in &r.scenes {
         s += &format!(
             "{:<14} {:<24} {:<24} {}\n",

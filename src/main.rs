@@ -408,7 +408,7 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
         );
     }
     let packed = veach::packed::PackedScene::new(&scene);
-    let (bvh_nodes, bvh_seconds) = (packed.nodes.len(), packed.bvh_build_seconds);
+    let (bvh_nodes, bvh_seconds) = (packed.bvh_nodes, packed.bvh_build_seconds);
     let mut renderer = open_renderer(packed, &camera, &job.settings(), args.backend)?;
     let mut done = 0u32;
     if let Some(film) = resumed {

@@ -8,8 +8,9 @@ use crate::scene::{AlphaMode, Material, PunctualKind, Scene, Texture, TextureRef
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
-/// BVH2 node: an inner node's children are `index` and `index + 1`; a leaf (`count > 0`)
-/// holds triangles `index .. index + count`.
+/// BVH2 node of the top level over instances: an inner node's children are `index` and
+/// `index + 1`; a leaf (`count > 0`) holds instances `index .. index + count`. Also the slot
+/// size of the node buffer: mesh BVH nodes take three slots, instance records four.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct BvhNode {
@@ -17,6 +18,30 @@ pub struct BvhNode {
     pub index: u32,
     pub max: [f32; 3],
     pub count: u32,
+}
+
+/// Compressed 8-wide BVH node (Ylitie, Karras & Laine 2017, built by obvhs) over a mesh's
+/// triangles, in three BvhNode slots (80 bytes and 16 of padding): node `i` of the buffer
+/// starts at slot `3 i`. Child boxes are quantised to 8 bits on a grid with origin `p` and
+/// power-of-two cell sizes, rounded outwards.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct CwNode {
+    pub p: [f32; 3],
+    /// Exponents of the cell sizes (bytes 0–2) and the inner-child mask `imask` (byte 3).
+    pub e_imask: u32,
+    /// First inner child; the others follow in slot order.
+    pub child_base: u32,
+    /// First triangle of the leaves; each leaf child's offset is in its `child_meta`.
+    pub primitive_base: u32,
+    /// One byte a child: 0 empty; inner: 0b001_11sss (slot s); leaf: triangle count in
+    /// unary (bits 5–7) and offset from `primitive_base` (bits 0–4).
+    pub child_meta: [u32; 2],
+    /// Quantised child bounds, one byte a child: x min (8 bytes), x max (8), then y, then z.
+    pub qx: [u32; 4],
+    pub qy: [u32; 4],
+    pub qz: [u32; 4],
+    pub pad: [u32; 4],
 }
 
 /// A triangle as intersected: vertex 0 and two edges (Möller–Trumbore form).
@@ -142,9 +167,10 @@ pub struct LightEntry {
 
 #[derive(Clone)]
 pub struct PackedScene {
-    /// BVH nodes. With instances: the top-level BVH over instances from node 0, then the
-    /// world mesh's and each stored mesh's BVH, then the instance records (four node-sized
-    /// slots each, from `instance_base`).
+    /// BVH nodes in BvhNode-sized slots. Without instances: the mesh's CWBVH (CwNode, three
+    /// slots each) from slot 0. With instances: the top-level BVH2 over instances from slot 0,
+    /// then the world mesh's and each stored mesh's CWBVH (starting at a multiple of three
+    /// slots), then the instance records (four slots each, from `instance_base`).
     pub nodes: Vec<BvhNode>,
     pub instance_base: u32,
     /// Instance records, the world mesh's (identity) included; 0 without instancing.
@@ -156,6 +182,8 @@ pub struct PackedScene {
     /// Original scene index of each packed triangle.
     pub order: Vec<u32>,
     pub bvh_build_seconds: f64,
+    /// BVH nodes: the meshes' CWBVH nodes and the top level's BVH2 nodes.
+    pub bvh_nodes: usize,
     pub environment: Vec3,
     /// Environment map texels (rgb, conditional CDF of the row up to this texel), then one
     /// row per map row (marginal CDF up to this row, 0, 0, 0). One zeroed element when there
@@ -211,13 +239,11 @@ impl PackedScene {
         }
         let mut attributes: Vec<PackedAttributes> = ordered.iter().map(|t| pack_attributes(t)).collect();
         attributes.resize(triangles.len(), PackedAttributes::zeroed());
-        let mut nodes = bvh.nodes;
-        let mut build_seconds = bvh.build_seconds;
-        let mut instance_base = 0;
-        if !scene.instances.is_empty() {
-            (nodes, instance_base, build_seconds) =
-                build_instances(scene, nodes, &mut triangles, &mut attributes, build_seconds);
-        }
+        let (nodes, instance_base, build_seconds, bvh_nodes) = if scene.instances.is_empty() {
+            (cw_slots(&bvh.nodes), 0, bvh.build_seconds, bvh.nodes.len())
+        } else {
+            build_instances(scene, bvh.nodes, &mut triangles, &mut attributes, bvh.build_seconds)
+        };
         let nodes_len = nodes.len();
         let (mut env, env_width, env_height, env_total) = match &scene.environment_map {
             Some(map) => pack_environment(map),
@@ -259,6 +285,7 @@ impl PackedScene {
             lights,
             order: bvh.order,
             bvh_build_seconds: build_seconds,
+            bvh_nodes,
             environment: scene.environment,
             env,
             punctual_base,
@@ -376,21 +403,21 @@ fn rows(m: glam::Mat4) -> [[f32; 4]; 3] {
 
 /// Two-level BVH: each stored mesh's BVH (object space) after the world mesh's, the instance
 /// records after them, and a top-level BVH over instance bounds at node 0. Returns the nodes,
-/// the first instance slot and the build time.
+/// the first instance slot, the build time and the node count.
 fn build_instances(
     scene: &Scene,
-    world_nodes: Vec<BvhNode>,
+    world_nodes: Vec<CwNode>,
     triangles: &mut Vec<PackedTriangle>,
     attributes: &mut Vec<PackedAttributes>,
     mut seconds: f64,
-) -> (Vec<BvhNode>, u32, f64) {
+) -> (Vec<BvhNode>, u32, f64, usize) {
     // Items: the world mesh (identity) when it has triangles, then every instance.
     struct Item {
         blas_root: u32,
         transform: glam::Mat4,
         bounds: crate::scene::Bounds,
     }
-    let mut blas_nodes: Vec<BvhNode> = Vec::new();
+    let mut blas_nodes: Vec<CwNode> = Vec::new();
     let mut items = Vec::new();
     let world_bounds = {
         let mut b = crate::scene::Bounds::empty();
@@ -399,15 +426,12 @@ fn build_instances(
     };
     // Node indices are fixed up once the top level's size is known: BLAS roots are relative
     // to the start of the BLAS block for now.
-    let append_blas = |nodes: &[BvhNode], tri_offset: u32, blas_nodes: &mut Vec<BvhNode>| -> u32 {
+    let append_blas = |nodes: &[CwNode], tri_offset: u32, blas_nodes: &mut Vec<CwNode>| -> u32 {
         let base = blas_nodes.len() as u32;
         blas_nodes.extend(nodes.iter().map(|n| {
             let mut n = *n;
-            if n.count > 0 {
-                n.index += tri_offset;
-            } else {
-                n.index += base;
-            }
+            n.child_base += base;
+            n.primitive_base += tri_offset;
             n
         }));
         base
@@ -473,14 +497,15 @@ fn build_instances(
         work.push((left, lo, mid));
         work.push((left + 1, mid, hi));
     }
-    let blas_base = tlas.len() as u32;
+    // The mesh BVHs start at a node index of their own: a multiple of three slots.
+    tlas.resize(tlas.len().next_multiple_of(3), BvhNode::zeroed());
+    let blas_base = tlas.len() as u32 / 3;
     for n in &mut blas_nodes {
-        if n.count == 0 {
-            n.index += blas_base;
-        }
+        n.child_base += blas_base;
     }
+    let node_count = tlas.len() + blas_nodes.len();
     let mut nodes = tlas;
-    nodes.extend(blas_nodes);
+    nodes.extend(cw_slots(&blas_nodes));
     let instance_base = nodes.len() as u32;
     for &i in &order {
         let it = &items[i];
@@ -493,7 +518,12 @@ fn build_instances(
         };
         nodes.extend_from_slice(bytemuck::cast_slice::<PackedInstance, BvhNode>(&[record]));
     }
-    (nodes, instance_base, seconds)
+    (nodes, instance_base, seconds, node_count)
+}
+
+/// CWBVH nodes as node-buffer slots.
+fn cw_slots(nodes: &[CwNode]) -> Vec<BvhNode> {
+    bytemuck::cast_slice(nodes).to_vec()
 }
 
 /// The environment's texels with the CDFs of the piecewise-constant distribution

@@ -32,13 +32,17 @@ fn soup(count: usize, rng: &mut Lcg) -> Scene {
 }
 
 fn check(scene: &Scene, rays: usize, rng: &mut Lcg) {
+    check_with(scene, rays, rng, |rng| (rng.v() * 2.0 - 1.0).normalize());
+}
+
+fn check_with(scene: &Scene, rays: usize, rng: &mut Lcg, mut direction: impl FnMut(&mut Lcg) -> Vec3) {
     let packed = PackedScene::new(scene);
     let b = scene.bounds();
     let (lo, size) = (b.min - 0.2 * b.diagonal(), 1.4 * b.diagonal());
     let mut hits = 0;
     for _ in 0..rays {
         let origin = lo + rng.v() * size;
-        let dir = (rng.v() * 2.0 - 1.0).normalize();
+        let dir = direction(rng);
         let ray = Ray { origin, dir };
         let bvh = intersect_closest(&packed, &ray);
         let mut brute = (INF, NO_HIT);
@@ -72,6 +76,25 @@ fn bvh_closest_hit_equals_brute_force() {
         let (scene, _) = veach::load(&common::asset(name), None).expect("asset loads");
         check(&scene, 10_000, &mut rng);
     }
+}
+
+/// Directions with exactly zero components: the quantised boxes' coordinate 0 meets an
+/// infinite 1/dir there unless traversal guards it (0 · ∞ = NaN would miss the box).
+#[test]
+fn bvh_finds_hits_of_axis_parallel_rays() {
+    let mut rng = Lcg(11);
+    let axis_parallel = |rng: &mut Lcg| {
+        let mut d = rng.v() * 2.0 - 1.0;
+        let k = (rng.f() * 6.0) as usize;
+        match k {
+            0..=2 => d[k] = 0.0,
+            _ => d = Vec3::AXES[k - 3] * if d.x < 0.0 { -1.0 } else { 1.0 },
+        }
+        d.normalize()
+    };
+    check_with(&soup(3000, &mut rng), 10_000, &mut rng, axis_parallel);
+    let (scene, _) = veach::load(&common::asset("cornell-box.gltf"), None).expect("asset loads");
+    check_with(&scene, 10_000, &mut rng, axis_parallel);
 }
 
 #[test]

@@ -1,13 +1,19 @@
-//! Acceleration structure: a BVH2 built on the CPU with obvhs (PLOC + reinsertion, SAH
-//! quality), flattened into 32-byte nodes that the WGSL traversal and the CPU reference share.
+//! Acceleration structure: a compressed 8-wide BVH (Ylitie, Karras & Laine 2017) built on the
+//! CPU by obvhs (PLOC + reinsertion, SAH quality, then collapsed to 8-wide nodes with
+//! quantised child boxes), which the WGSL traversal and the CPU reference share.
+//!
+//! Why 8-wide and compressed: lavapipe loads storage buffers lane by lane and dword by dword,
+//! so a ray's cost follows the bytes it reads; an 80-byte node holds eight child boxes where
+//! a BVH2 reads 64 bytes for two (BENCHMARKS.md: 1.4× samples/s on lavapipe).
 
-use crate::packed::BvhNode;
+use crate::packed::CwNode;
+use bytemuck::Zeroable;
 use glam::Vec3;
-use obvhs::{BvhBuildParams, bvh2::builder::build_bvh2_from_tris, triangle::Triangle as BvhTriangle};
+use obvhs::{BvhBuildParams, cwbvh::builder::build_cwbvh_from_tris, triangle::Triangle as BvhTriangle};
 use std::time::{Duration, Instant};
 
 pub struct Bvh {
-    pub nodes: Vec<BvhNode>,
+    pub nodes: Vec<CwNode>,
     /// Triangle order of the leaves: leaf primitive `i` is scene triangle `order[i]`.
     pub order: Vec<u32>,
     pub build_seconds: f64,
@@ -17,18 +23,22 @@ pub struct Bvh {
 pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
     let start = Instant::now();
     if triangles.is_empty() {
-        // One leaf holding one degenerate triangle (added by the packer): rays can enter
-        // it, but a zero-area triangle is never hit, so traversal needs no special case.
-        let node = BvhNode { min: [0.0; 3], index: 0, max: [0.0; 3], count: 1 };
-        return Bvh { nodes: vec![node], order: Vec::new(), build_seconds: 0.0 };
+        // A root with no children: rays enter it and find nothing.
+        return Bvh { nodes: vec![CwNode::zeroed()], order: Vec::new(), build_seconds: 0.0 };
     }
     let tris: Vec<BvhTriangle> =
         triangles.iter().map(|t| BvhTriangle { v0: t[0].into(), v1: t[1].into(), v2: t[2].into() }).collect();
-    let bvh = build_bvh2_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
+    let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
+    // obvhs's node is our CwNode without the padding (same field order, little-endian bytes).
     let nodes = bvh
         .nodes
         .iter()
-        .map(|n| BvhNode { min: n.aabb.min.into(), index: n.first_index, max: n.aabb.max.into(), count: n.prim_count })
+        .map(|n| {
+            let mut node = CwNode::zeroed();
+            bytemuck::bytes_of_mut(&mut node)[..80].copy_from_slice(bytemuck::bytes_of(n));
+            node
+        })
         .collect();
+    debug_assert_eq!(bvh.primitive_indices.len(), triangles.len());
     Bvh { nodes, order: bvh.primitive_indices, build_seconds: start.elapsed().as_secs_f64() }
 }

@@ -2,11 +2,12 @@
 
 use super::instance::{load_instance, transform_dir, transform_point};
 use super::material::alpha_passes;
-use crate::packed::{BvhNode, PackedScene, PackedTriangle, TRI_ALPHA};
-use glam::{IVec3, Vec3};
+use crate::packed::{BvhNode, CwNode, PackedScene, PackedTriangle, TRI_ALPHA};
+use glam::{IVec3, UVec2, UVec3, Vec3, Vec3A, Vec4};
 
 pub const NO_HIT: u32 = u32::MAX;
-const STACK_SIZE: usize = 64;
+const STACK_SIZE: usize = 32;
+const TLAS_STACK_SIZE: usize = 64;
 pub const INF: f32 = 3.4e38;
 
 #[derive(Clone, Copy, Debug)]
@@ -51,9 +52,9 @@ pub fn intersect_triangle(ray: &Ray, tri: &PackedTriangle) -> Vec3 {
 /// operands; either way the test only gets more permissive, so no hit is lost.
 #[inline(always)]
 pub fn intersect_node(node: &BvhNode, origin: Vec3, inv_dir: Vec3, t_max: f32) -> f32 {
-    let (origin, inv_dir) = (glam::Vec3A::from(origin), glam::Vec3A::from(inv_dir));
-    let t0 = (glam::Vec3A::from(node.min) - origin) * inv_dir;
-    let t1 = (glam::Vec3A::from(node.max) - origin) * inv_dir;
+    let (origin, inv_dir) = (Vec3A::from(origin), Vec3A::from(inv_dir));
+    let t0 = (Vec3A::from(node.min) - origin) * inv_dir;
+    let t1 = (Vec3A::from(node.max) - origin) * inv_dir;
     let near = t0.min(t1);
     let far = t0.max(t1);
     let t_enter = near.x.max(near.y).max(near.z.max(0.0));
@@ -61,20 +62,97 @@ pub fn intersect_node(node: &BvhNode, origin: Vec3, inv_dir: Vec3, t_max: f32) -
     if t_enter <= t_exit { t_enter } else { INF }
 }
 
-pub fn trace_blas(scene: &PackedScene, ray: &Ray, root: u32, best: Hit, any_hit: bool, instance: u32) -> Hit {
-    let (nodes, triangles): (&[BvhNode], &[PackedTriangle]) = (&scene.nodes, &scene.triangles);
-    let mut hit = best;
-    let inv_dir = Vec3::ONE / ray.dir;
-    let mut stack = [0u32; STACK_SIZE];
-    let mut sp = 0usize;
-    let mut index = root as usize;
-    if intersect_node(&nodes[index], ray.origin, inv_dir, hit.t) == INF {
-        return hit;
+/// The node of the mesh BVHs at index `i` (three slots from slot `3 i`).
+#[inline(always)]
+pub fn load_cw_node(scene: &PackedScene, i: u32) -> &CwNode {
+    let s = 3 * i as usize;
+    bytemuck::from_bytes(bytemuck::cast_slice(&scene.nodes[s..s + 3]))
+}
+
+/// Hit mask of a compressed node's children (see shaders/bvh.wgsl), four children per SSE
+/// register: the same operations per child as the shader's loop.
+#[inline(always)]
+pub fn intersect_cw_node(node: &CwNode, origin: Vec3, inv_dir: Vec3, t_max: f32, oct_inv4: u32) -> u32 {
+    let e = UVec3::splat(node.e_imask) >> UVec3::new(0, 8, 16) & UVec3::splat(0xff);
+    let scale = Vec3::new(f32::from_bits(e.x << 23), f32::from_bits(e.y << 23), f32::from_bits(e.z << 23)) * inv_dir;
+    let shift = (Vec3::from(node.p) - origin) * inv_dir;
+    let bytes =
+        |w: u32| Vec4::new((w & 0xff) as f32, (w >> 8 & 0xff) as f32, (w >> 16 & 0xff) as f32, (w >> 24) as f32);
+    let mut mask = 0;
+    for half in 0..2 {
+        let slab = |q: &[u32; 4], axis: usize| {
+            let t0 = bytes(q[half]) * scale[axis] + Vec4::splat(shift[axis]);
+            let t1 = bytes(q[2 + half]) * scale[axis] + Vec4::splat(shift[axis]);
+            (t0.min(t1), t0.max(t1))
+        };
+        let ((near_x, far_x), (near_y, far_y), (near_z, far_z)) =
+            (slab(&node.qx, 0), slab(&node.qy, 1), slab(&node.qz, 2));
+        let t_enter = near_x.max(near_y).max(near_z.max(Vec4::ZERO));
+        let t_exit = far_x.min(far_y).min(far_z.min(Vec4::splat(t_max)));
+        let mut hits = t_enter.cmple(t_exit).bitmask();
+        while hits != 0 {
+            let lane = hits.trailing_zeros();
+            hits &= hits - 1;
+            let child_meta = (node.child_meta[half] >> (8 * lane)) & 0xff;
+            let is_inner = child_meta & (child_meta << 1) & 0x10 != 0;
+            let bit_index = (child_meta ^ if is_inner { oct_inv4 & 0xff } else { 0 }) & 0x1f;
+            mask |= ((child_meta >> 5) & 7) << bit_index;
+        }
     }
+    mask
+}
+
+/// 1 / dir, with components nearer zero than 2⁻⁸⁰ replaced by ±2⁻⁸⁰, so that a quantised
+/// box coordinate of 0 never meets an infinite reciprocal (0 · ∞ = NaN would fail the test).
+#[inline(always)]
+pub fn safe_inv_dir(dir: Vec3) -> Vec3 {
+    const TINY: f32 = 8.271806e-25; // 2⁻⁸⁰
+    let fix = |d: f32| {
+        if d.abs() >= TINY {
+            d
+        } else if d < 0.0 {
+            -TINY
+        } else {
+            TINY
+        }
+    };
+    Vec3::ONE / Vec3::new(fix(dir.x), fix(dir.y), fix(dir.z))
+}
+
+/// The ray's octant, inverted, in each byte.
+#[inline(always)]
+pub fn octant_inv4(dir: Vec3) -> u32 {
+    (if dir.x < 0.0 { 0 } else { 0x04040404 })
+        | (if dir.y < 0.0 { 0 } else { 0x02020202 })
+        | (if dir.z < 0.0 { 0 } else { 0x01010101 })
+}
+
+pub fn trace_blas(scene: &PackedScene, ray: &Ray, root: u32, best: Hit, any_hit: bool, instance: u32) -> Hit {
+    let triangles: &[PackedTriangle] = &scene.triangles;
+    let mut hit = best;
+    let inv_dir = safe_inv_dir(ray.dir);
+    let oct_inv4 = octant_inv4(ray.dir);
+    let mut stack = [UVec2::ZERO; STACK_SIZE];
+    let mut sp = 0usize;
+    let mut group = UVec2::new(root, 0x80000000);
     loop {
-        let node = &nodes[index];
-        if node.count > 0 {
-            for i in node.index..node.index + node.count {
+        if group.y > 0x00ffffff {
+            let hits = group.y;
+            let child_bit = 31 - hits.leading_zeros();
+            group.y = hits & !(1 << child_bit);
+            if group.y > 0x00ffffff && sp < STACK_SIZE {
+                stack[sp] = group;
+                sp += 1;
+            }
+            let slot = (child_bit - 24) ^ (oct_inv4 & 0xff);
+            let node = load_cw_node(scene, group.x + (hits & !(u32::MAX << slot)).count_ones());
+            let mask = intersect_cw_node(node, ray.origin, inv_dir, hit.t, oct_inv4);
+            group = UVec2::new(node.child_base, (mask & 0xff000000) | (node.e_imask >> 24));
+            let mut tris = mask & 0x00ffffff;
+            while tris != 0 {
+                let k = 31 - tris.leading_zeros();
+                tris &= !(1 << k);
+                let i = node.primitive_base + k;
                 let tri = &triangles[i as usize];
                 let r = intersect_triangle(ray, tri);
                 if r.x < hit.t && (tri.flags & TRI_ALPHA == 0 || alpha_passes(scene, i, r.y, r.z, ray)) {
@@ -84,33 +162,14 @@ pub fn trace_blas(scene: &PackedScene, ray: &Ray, root: u32, best: Hit, any_hit:
                     }
                 }
             }
-        } else {
-            let (left, right) = (node.index as usize, node.index as usize + 1);
-            let t_left = intersect_node(&nodes[left], ray.origin, inv_dir, hit.t);
-            let t_right = intersect_node(&nodes[right], ray.origin, inv_dir, hit.t);
-            if t_left != INF && t_right != INF {
-                let near_is_left = t_left <= t_right;
-                if sp < STACK_SIZE {
-                    stack[sp] = if near_is_left { right } else { left } as u32;
-                    sp += 1;
-                }
-                index = if near_is_left { left } else { right };
-                continue;
-            }
-            if t_left != INF {
-                index = left;
-                continue;
-            }
-            if t_right != INF {
-                index = right;
-                continue;
-            }
         }
-        if sp == 0 {
-            break;
+        if group.y <= 0x00ffffff {
+            if sp == 0 {
+                break;
+            }
+            sp -= 1;
+            group = stack[sp];
         }
-        sp -= 1;
-        index = stack[sp] as usize;
     }
     hit
 }
@@ -122,7 +181,7 @@ pub fn trace(scene: &PackedScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
     }
     let nodes = &scene.nodes[..];
     let inv_dir = Vec3::ONE / ray.dir;
-    let mut stack = [0u32; STACK_SIZE];
+    let mut stack = [0u32; TLAS_STACK_SIZE];
     let mut sp = 0usize;
     let mut index = 0usize;
     if intersect_node(&nodes[0], ray.origin, inv_dir, hit.t) == INF {
@@ -148,7 +207,7 @@ pub fn trace(scene: &PackedScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
             let t_right = intersect_node(&nodes[right], ray.origin, inv_dir, hit.t);
             if t_left != INF && t_right != INF {
                 let near_is_left = t_left <= t_right;
-                if sp < STACK_SIZE {
+                if sp < TLAS_STACK_SIZE {
                     stack[sp] = if near_is_left { right } else { left } as u32;
                     sp += 1;
                 }
