@@ -7,8 +7,8 @@
 #include "instance.wgsl"
 
 const NO_HIT: u32 = 0xffffffffu;
-// Groups of up to eight children: 32 entries are deep enough for any 8-wide BVH that fits in
-// memory; the top level is a BVH2.
+// A mesh walk pushes at most one group of up to eight children per tree level: 32 levels of
+// an 8-wide tree. The top level is a BVH2.
 const STACK_SIZE: u32 = 32u;
 const TLAS_STACK_SIZE: u32 = 64u;
 
