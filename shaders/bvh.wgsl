@@ -7,8 +7,8 @@
 #include "instance.wgsl"
 
 const NO_HIT: u32 = 0xffffffffu;
-// A mesh walk pushes at most one group of up to eight children per tree level: 32 levels of
-// an 8-wide tree. The top level is a BVH2.
+// A mesh walk pushes at most one group of up to eight children per tree level, and a renderer
+// refuses mesh BVHs deeper than 32 levels (accel::MAX_DEPTH). The top level is a BVH2.
 const STACK_SIZE: u32 = 32u;
 const TLAS_STACK_SIZE: u32 = 64u;
 
@@ -167,7 +167,7 @@ fn trace(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
     if (!INSTANCING) {
         return trace_blas(ray, 0u, hit, any_hit, 0u);
     }
-    let inv_dir = 1.0 / ray.dir;
+    let inv_dir = safe_inv_dir(ray.dir);
     var sp = 0u;
     var index = 0u;
     if (intersect_node(load_node(0u), ray.origin, inv_dir, hit.t) == INF) {

@@ -226,8 +226,8 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> (Vec<R
     (vec![primary_result, shadow_result, diffuse_result], [primary, shadow, diffuse])
 }
 
-/// The batches of `ray_throughput` through obvhs's CWBVH (built from the same triangles with
-/// the same build settings) and its traversal, with our triangle test; an error when the two
+/// The batches of `ray_throughput` through a CWBVH that obvhs builds from the packed triangles
+/// (same build settings as ours) and walks with its own SIMD traversal, with our triangle test; an error when the two
 /// walks do not find the same hits (then the rates would compare different work).
 fn cwbvh_ray_throughput(scene: &PackedScene, batches: &[Vec<Ray>; 3]) -> Result<(Vec<RayResult>, f64), String> {
     use obvhs::ray::{Ray as ORay, RayHit};

@@ -246,6 +246,13 @@ impl Renderer {
         if w == 0 || h == 0 || w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE {
             return Err(Error::Limit(format!("image size {w}x{h} is outside 1..={MAX_IMAGE_SIDE} per side")));
         }
+        if scene.bvh_depth > accel::MAX_DEPTH {
+            return Err(Error::Limit(format!(
+                "the scene's BVH is {} levels deep; traversal walks at most {}",
+                scene.bvh_depth,
+                accel::MAX_DEPTH
+            )));
+        }
         let tile = settings.tile.unwrap_or(Tile { x: 0, y: 0, width: w, height: h });
         if tile.width == 0 || tile.height == 0 || tile.x + tile.width > w || tile.y + tile.height > h {
             return Err(Error::Input(format!(

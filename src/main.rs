@@ -408,7 +408,7 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
         );
     }
     let packed = veach::packed::PackedScene::new(&scene);
-    let (bvh_nodes, bvh_seconds) = (packed.bvh_nodes, packed.bvh_build_seconds);
+    let (bvh_nodes, bvh_depth, bvh_seconds) = (packed.bvh_nodes, packed.bvh_depth, packed.bvh_build_seconds);
     let mut renderer = open_renderer(packed, &camera, &job.settings(), args.backend)?;
     let mut done = 0u32;
     if let Some(film) = resumed {
@@ -523,6 +523,7 @@ fn render(args: &RenderArgs) -> Result<Outcome, Error> {
             "samples_per_second": samples_per_second,
             "triangles": triangles,
             "bvh_nodes": bvh_nodes,
+            "bvh_depth": bvh_depth,
             "bvh_build_seconds": bvh_seconds,
             "nonfinite_samples": nonfinite,
             "gpu_bytes": renderer.gpu_bytes(),

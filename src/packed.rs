@@ -184,6 +184,8 @@ pub struct PackedScene {
     pub bvh_build_seconds: f64,
     /// BVH nodes: the meshes' CWBVH nodes and the top level's BVH2 nodes.
     pub bvh_nodes: usize,
+    /// Levels of the deepest mesh BVH (see accel::MAX_DEPTH).
+    pub bvh_depth: u32,
     pub environment: Vec3,
     /// Environment map texels (rgb, conditional CDF of the row up to this texel), then one
     /// row per map row (marginal CDF up to this row, 0, 0, 0). One zeroed element when there
@@ -234,15 +236,16 @@ impl PackedScene {
         let mut triangles: Vec<PackedTriangle> =
             ordered.iter().zip(&light_pdf).map(|(t, &pdf)| pack_triangle(scene, t, pdf)).collect();
         if triangles.is_empty() {
-            // The empty BVH's leaf points at one zero-area triangle that no ray hits.
+            // No triangle is referenced (the empty BVH's root has no children), but a storage
+            // binding needs at least one element.
             triangles.push(PackedTriangle::zeroed());
         }
         let mut attributes: Vec<PackedAttributes> = ordered.iter().map(|t| pack_attributes(t)).collect();
         attributes.resize(triangles.len(), PackedAttributes::zeroed());
-        let (nodes, instance_base, build_seconds, bvh_nodes) = if scene.instances.is_empty() {
-            (cw_slots(&bvh.nodes), 0, bvh.build_seconds, bvh.nodes.len())
+        let (nodes, instance_base, build_seconds, bvh_nodes, bvh_depth) = if scene.instances.is_empty() {
+            (cw_slots(&bvh.nodes), 0, bvh.build_seconds, bvh.nodes.len(), bvh.depth)
         } else {
-            build_instances(scene, bvh.nodes, &mut triangles, &mut attributes, bvh.build_seconds)
+            build_instances(scene, bvh.nodes, bvh.depth, &mut triangles, &mut attributes, bvh.build_seconds)
         };
         let nodes_len = nodes.len();
         let (mut env, env_width, env_height, env_total) = match &scene.environment_map {
@@ -286,6 +289,7 @@ impl PackedScene {
             order: bvh.order,
             bvh_build_seconds: build_seconds,
             bvh_nodes,
+            bvh_depth,
             environment: scene.environment,
             env,
             punctual_base,
@@ -403,14 +407,15 @@ fn rows(m: glam::Mat4) -> [[f32; 4]; 3] {
 
 /// Two-level BVH: each stored mesh's BVH (object space) after the world mesh's, the instance
 /// records after them, and a top-level BVH over instance bounds at node 0. Returns the nodes,
-/// the first instance slot, the build time and the node count.
+/// the first instance slot, the build time, the node count and the deepest mesh BVH's depth.
 fn build_instances(
     scene: &Scene,
     world_nodes: Vec<CwNode>,
+    world_depth: u32,
     triangles: &mut Vec<PackedTriangle>,
     attributes: &mut Vec<PackedAttributes>,
     mut seconds: f64,
-) -> (Vec<BvhNode>, u32, f64, usize) {
+) -> (Vec<BvhNode>, u32, f64, usize, u32) {
     // Items: the world mesh (identity) when it has triangles, then every instance.
     struct Item {
         blas_root: u32,
@@ -418,6 +423,7 @@ fn build_instances(
         bounds: crate::scene::Bounds,
     }
     let mut blas_nodes: Vec<CwNode> = Vec::new();
+    let mut depth = world_depth;
     let mut items = Vec::new();
     let world_bounds = {
         let mut b = crate::scene::Bounds::empty();
@@ -445,6 +451,7 @@ fn build_instances(
         let verts: Vec<[Vec3; 3]> = mesh.triangles.iter().map(|t| t.positions).collect();
         let bvh = accel::build(&verts);
         seconds += bvh.build_seconds;
+        depth = depth.max(bvh.depth);
         let tri_offset = triangles.len() as u32;
         if mesh.triangles.is_empty() {
             triangles.push(PackedTriangle::zeroed());
@@ -497,13 +504,13 @@ fn build_instances(
         work.push((left, lo, mid));
         work.push((left + 1, mid, hi));
     }
+    let node_count = tlas.len() + blas_nodes.len();
     // The mesh BVHs start at a node index of their own: a multiple of three slots.
     tlas.resize(tlas.len().next_multiple_of(3), BvhNode::zeroed());
     let blas_base = tlas.len() as u32 / 3;
     for n in &mut blas_nodes {
         n.child_base += blas_base;
     }
-    let node_count = tlas.len() + blas_nodes.len();
     let mut nodes = tlas;
     nodes.extend(cw_slots(&blas_nodes));
     let instance_base = nodes.len() as u32;
@@ -518,7 +525,7 @@ fn build_instances(
         };
         nodes.extend_from_slice(bytemuck::cast_slice::<PackedInstance, BvhNode>(&[record]));
     }
-    (nodes, instance_base, seconds, node_count)
+    (nodes, instance_base, seconds, node_count, depth)
 }
 
 /// CWBVH nodes as node-buffer slots.

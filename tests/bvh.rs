@@ -103,3 +103,21 @@ fn bvh_of_an_empty_scene_misses() {
     let ray = Ray { origin: Vec3::ZERO, dir: Vec3::Z };
     assert_eq!(intersect_closest(&packed, &ray).tri, NO_HIT);
 }
+
+/// The measured depth is plausible for an 8-wide tree, and a scene deeper than the traversal
+/// stacks is refused with a named limit instead of rendering with missed hits.
+#[test]
+fn bvh_depth_is_measured_and_bounded() {
+    let mut rng = Lcg(3);
+    let scene = soup(3000, &mut rng);
+    let mut packed = PackedScene::new(&scene);
+    // 3000 triangles, at most 3 a leaf and 8 children a node: at least 4 levels.
+    assert!((4..=veach::accel::MAX_DEPTH).contains(&packed.bvh_depth), "depth {}", packed.bvh_depth);
+    packed.bvh_depth = veach::accel::MAX_DEPTH + 1;
+    let camera = scene.camera(None).expect("camera");
+    match veach::Renderer::new(packed, &camera, &common::settings(8, 1, 0), veach::Backend::Cpu) {
+        Err(veach::Error::Limit(m)) => assert!(m.contains("levels deep"), "{m}"),
+        Err(e) => panic!("expected a limit error, got {e}"),
+        Ok(_) => panic!("a BVH deeper than the stacks was accepted"),
+    }
+}

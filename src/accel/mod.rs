@@ -17,20 +17,27 @@ pub struct Bvh {
     /// Triangle order of the leaves: leaf primitive `i` is scene triangle `order[i]`.
     pub order: Vec<u32>,
     pub build_seconds: f64,
+    /// Levels of nodes from the root to the deepest leaf (1 for a root alone).
+    pub depth: u32,
 }
+
+/// The deepest BVH the traversal stacks can walk without dropping a subtree: a walk pushes at
+/// most one group of children per level. Twin of STACK_SIZE in shaders/bvh.wgsl and
+/// src/cpu/bvh.rs.
+pub const MAX_DEPTH: u32 = 32;
 
 /// Builds the BVH over triangles given by their three vertices.
 pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
     let start = Instant::now();
     if triangles.is_empty() {
         // A root with no children: rays enter it and find nothing.
-        return Bvh { nodes: vec![CwNode::zeroed()], order: Vec::new(), build_seconds: 0.0 };
+        return Bvh { nodes: vec![CwNode::zeroed()], order: Vec::new(), build_seconds: 0.0, depth: 1 };
     }
     let tris: Vec<BvhTriangle> =
         triangles.iter().map(|t| BvhTriangle { v0: t[0].into(), v1: t[1].into(), v2: t[2].into() }).collect();
     let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
     // obvhs's node is our CwNode without the padding (same field order, little-endian bytes).
-    let nodes = bvh
+    let nodes: Vec<CwNode> = bvh
         .nodes
         .iter()
         .map(|n| {
@@ -40,5 +47,20 @@ pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
         })
         .collect();
     debug_assert_eq!(bvh.primitive_indices.len(), triangles.len());
-    Bvh { nodes, order: bvh.primitive_indices, build_seconds: start.elapsed().as_secs_f64() }
+    let depth = depth(&nodes);
+    Bvh { nodes, order: bvh.primitive_indices, build_seconds: start.elapsed().as_secs_f64(), depth }
+}
+
+/// Levels of the tree under node 0: PLOC bounds no depth, so it is measured, and a renderer
+/// refuses a scene deeper than MAX_DEPTH rather than miss hits.
+fn depth(nodes: &[CwNode]) -> u32 {
+    let mut deepest = 0;
+    let mut work = vec![(0usize, 1u32)];
+    while let Some((i, level)) = work.pop() {
+        deepest = deepest.max(level);
+        let n = &nodes[i];
+        let inner = (n.e_imask >> 24).count_ones() as usize;
+        work.extend((0..inner).map(|k| (n.child_base as usize + k, level + 1)));
+    }
+    deepest
 }
