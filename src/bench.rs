@@ -58,6 +58,8 @@ pub struct SceneResult {
     /// Packing the scene, BVH build included.
     pub pack_seconds: f64,
     pub bvh_nodes: usize,
+    /// Levels of the deepest mesh BVH.
+    pub bvh_depth: u32,
     /// Geometry, attributes and BVH as uploaded (nodes + triangles + vertex attributes).
     pub geometry_bytes_per_triangle: f64,
     pub renders: Vec<RenderResult>,
@@ -106,6 +108,7 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
             bvh_build_seconds: packed.bvh_build_seconds,
             pack_seconds,
             bvh_nodes: packed.bvh_nodes,
+            bvh_depth: packed.bvh_depth,
             geometry_bytes_per_triangle: geometry as f64 / tris as f64,
             renders: Vec::new(),
             rays: Vec::new(),
