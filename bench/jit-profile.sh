@@ -44,14 +44,17 @@ trap 'kill $pid 2>/dev/null || true' EXIT
 sleep "$warmup"
 kill -0 $pid 2>/dev/null || { echo "jit-profile: the render ended early:" >&2; cat "$out/render.log" >&2; exit 2; }
 perf record -q -o "$out/perf.data" -p $pid -- sleep "$seconds" 2>/dev/null
-# Every anonymous executable mapping (lavapipe's JIT code; the vdso is named, so excluded).
+# Every anonymous executable mapping (lavapipe's JIT code; the vdso is named, so excluded),
+# from a snapshot of the map: the JIT may map more code while we read.
+cp /proc/$pid/maps "$out/maps"
 : >"$out/jit.asm"
 while read -r range perms _ _ inode rest; do
     [ "$perms" = "r-xp" ] && [ "$inode" = "0" ] && [ -z "$rest" ] || continue
-    start=${range%-*} end=${range#*-}
-    gdb -p $pid -batch -ex "dump binary memory $out/jit-$start.bin 0x$start 0x$end" >/dev/null 2>&1
+    [[ "$range" =~ ^([0-9a-f]+)-([0-9a-f]+)$ ]] || continue
+    start=${BASH_REMATCH[1]} end=${BASH_REMATCH[2]}
+    gdb -p $pid -batch -ex "dump binary memory $out/jit-$start.bin 0x$start 0x$end" >/dev/null 2>&1 || continue
     objdump -D -b binary -mi386:x86-64 --adjust-vma=0x"$start" "$out/jit-$start.bin" >>"$out/jit.asm"
-done </proc/$pid/maps
+done <"$out/maps"
 kill $pid 2>/dev/null || true
 perf script -i "$out/perf.data" -F ip 2>/dev/null | sort | uniq -c >"$out/ips.txt"
 
