@@ -5,6 +5,20 @@
 const FILM_WORDS: u32 = 3u; // vec4<u32> rows per pixel
 const MAX_SAMPLE: f32 = 2147483520.0;
 
+// Where invocation `gid` of a dispatch writes: its film slot and its image pixel (the film
+// covers the tile, from row params.row_offset on); `inside` is false past the film's edge.
+struct FilmPixel {
+    slot: u32,
+    pixel: vec2<u32>,
+    inside: bool,
+}
+
+fn film_pixel(gid: vec3<u32>) -> FilmPixel {
+    let row = gid.y + params.row_offset;
+    let inside = gid.x < params.film_width && row < params.film_height;
+    return FilmPixel(row * params.film_width + gid.x, vec2<u32>(gid.x + params.tile_x, row + params.tile_y), inside);
+}
+
 fn film_add_sample(pixel: u32, l: vec3<f32>) {
     let base = FILM_WORDS * pixel;
     if (!is_finite_vec3(l)) {

@@ -157,12 +157,11 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
 
 @compute @workgroup_size(8, 8, 1)
 fn render_sample(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let row = gid.y + params.row_offset;
-    if (gid.x >= params.film_width || row >= params.film_height) {
+    let at = film_pixel(gid);
+    if (!at.inside) {
         return;
     }
-    let pixel = vec2<u32>(gid.x + params.tile_x, row + params.tile_y);
     var sampler: Sampler;
-    let ray = camera_sample(pixel, &sampler);
-    film_add_sample(row * params.film_width + gid.x, li(ray, &sampler));
+    let ray = camera_sample(at.pixel, &sampler);
+    film_add_sample(at.slot, li(ray, &sampler));
 }

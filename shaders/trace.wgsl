@@ -10,13 +10,12 @@ override TRACE_KIND: u32 = 0u;
 
 @compute @workgroup_size(8, 8, 1)
 fn trace_rays(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let row = gid.y + params.row_offset;
-    if (gid.x >= params.film_width || row >= params.film_height) {
+    let at = film_pixel(gid);
+    if (!at.inside) {
         return;
     }
-    let pixel = vec2<u32>(gid.x + params.tile_x, row + params.tile_y);
     var sampler: Sampler;
-    let ray = camera_sample(pixel, &sampler);
+    let ray = camera_sample(at.pixel, &sampler);
     let hit = intersect_closest(ray);
     var count = 0.0;
     if (hit.tri != NO_HIT) {
@@ -37,5 +36,5 @@ fn trace_rays(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
     }
-    film_add_sample(row * params.film_width + gid.x, vec3<f32>(count));
+    film_add_sample(at.slot, vec3<f32>(count));
 }

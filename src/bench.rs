@@ -230,8 +230,9 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> (Vec<R
 }
 
 /// The batches of `ray_throughput` through a CWBVH that obvhs builds from the packed triangles
-/// (same build settings as ours) and walks with its own SIMD traversal, with our triangle test; an error when the two
-/// walks do not find the same hits (then the rates would compare different work).
+/// (same build settings as ours) and walks with its own SIMD traversal, with our triangle
+/// test; an error when the two walks do not find the same hits (then the rates would compare
+/// different work).
 fn cwbvh_ray_throughput(scene: &PackedScene, batches: &[Vec<Ray>; 3]) -> Result<(Vec<RayResult>, f64), String> {
     use obvhs::ray::{Ray as ORay, RayHit};
     let tris: Vec<obvhs::triangle::Triangle> = scene

@@ -22,8 +22,8 @@ pub struct Bvh {
 }
 
 /// The deepest BVH the traversal stacks can walk without dropping a subtree: a walk pushes at
-/// most one group of children per level. Twin of STACK_SIZE in shaders/bvh.wgsl and
-/// src/cpu/bvh.rs.
+/// most one group of children per level. The CPU walk sizes its stack from it; STACK_SIZE in
+/// shaders/bvh.wgsl is its twin.
 pub const MAX_DEPTH: u32 = 32;
 
 /// Builds the BVH over triangles given by their three vertices.

@@ -232,18 +232,15 @@ impl GpuRenderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
+        let constants = scene.features().constants();
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("integrator"),
             layout: Some(&pipeline_layout),
             module: &module,
             entry_point: Some("render_sample"),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &scene.features().constants(),
-                ..Default::default()
-            },
+            compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             cache: None,
         });
-        let constants = scene.features().constants();
         let (film_buf, readback, bind_group) =
             Self::film(&ctx, &layout, &scene_buffers, geometry.as_ref(), &textures, &params_buf, params)?;
         let paged_bytes = if paged { geometry_bytes.iter().map(|b| b.len() as u64).sum() } else { 0 };
