@@ -1,0 +1,146 @@
+//! Regression guard for restructuring: the films of the bundled scenes, for fixed seeds, hash
+//! to the values recorded here. The films' correctness is checked elsewhere against
+//! independent references (tests/render.rs); this test only proves that moving code around
+//! changed no bit. A change that alters images on purpose updates the table and says why in
+//! its commit. The CPU engine's arithmetic is IEEE-754 without fused multiply-adds, but its
+//! transcendental functions come from the platform's libm, so the table is for x86_64 Linux
+//! (glibc); elsewhere the test reports itself skipped.
+
+mod common;
+
+use common::build::{GltfBuilder, MeshData};
+use glam::Vec3;
+use serde_json::json;
+use std::path::PathBuf;
+use veach::Settings;
+
+/// FNV-1a over the film's words: enough to detect any changed bit.
+fn fnv(words: &[u32]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for w in words {
+        for b in w.to_le_bytes() {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+    h
+}
+
+/// (scene, max depth, sampler, expected hash of a 48×48 film of 4 samples, seed 7).
+const FILMS: &[(&str, u32, veach::SamplerKind, u64)] = &[
+    ("cornell-box.gltf", 8, veach::SamplerKind::Sobol, 0xe1da898f5d51b302),
+    ("cornell-box.gltf", 8, veach::SamplerKind::Independent, 0x114b9e2aa4a45558),
+    ("cornell-glass.gltf", 8, veach::SamplerKind::Sobol, 0xc0acbc95243005ef),
+    ("veach-mis.gltf", 2, veach::SamplerKind::Sobol, 0x2a755b135aed0922),
+    ("furnace-a080.gltf", 8, veach::SamplerKind::Sobol, 0x4020415887b55e33),
+    ("furnace-a100.gltf", 8, veach::SamplerKind::Independent, 0xdcf88cd2ca2f48b4),
+];
+
+/// A scene that turns on every optional part of the kernel: a texture with alpha MASK, BLEND,
+/// a spot light, glass with absorption, instancing, a constant environment.
+fn features_scene() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("veach-films-{}", std::process::id()));
+    let mut b = GltfBuilder::new(&dir, "features");
+    b.use_extension("KHR_materials_transmission");
+    b.use_extension("KHR_materials_volume");
+    let checker = image::RgbaImage::from_fn(8, 8, |x, y| {
+        let on = (x + y) % 2 == 0;
+        image::Rgba(if on { [220, 40, 40, 255] } else { [40, 220, 40, 60] })
+    });
+    let tex = b.texture(&checker, 10497);
+    let masked = b.material(json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": tex},
+        "metallicFactor": 0}, "alphaMode": "MASK", "alphaCutoff": 0.5}));
+    let blended = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.9, 0.5],
+        "metallicFactor": 0, "roughnessFactor": 0.4}, "alphaMode": "BLEND"}));
+    let glass = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0,
+        "roughnessFactor": 0.1}, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+        "KHR_materials_volume": {"attenuationColor": [0.3, 0.6, 1.0], "attenuationDistance": 0.5}}}));
+    let lamp = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]},
+        "emissiveFactor": [4, 4, 4]}));
+    let floor = b.mesh(&MeshData::quad(-3.0, -3.0, 3.0, 3.0, -1.0, MeshData::UPRIGHT), masked);
+    b.node(json!({"mesh": floor}));
+    let veil = b.mesh(&MeshData::quad(-1.0, -1.0, 0.0, 0.0, 0.5, MeshData::UPRIGHT), blended);
+    b.node(json!({"mesh": veil}));
+    let pane = b.mesh(&MeshData::quad(-0.4, -0.4, 0.4, 0.4, 0.0, MeshData::UPRIGHT), glass);
+    b.node(json!({"mesh": pane, "translation": [0.8, 0.3, 0.0]}));
+    b.node(json!({"mesh": pane, "translation": [-0.6, 0.9, 0.2], "scale": [1.5, 0.7, 1.0]}));
+    let light = b.mesh(&MeshData::quad(-0.5, -0.5, 0.5, 0.5, 0.0, MeshData::UPRIGHT), lamp);
+    b.node(json!({"mesh": light, "translation": [2.0, -2.0, 2.5], "rotation": [1, 0, 0, 0]}));
+    b.light(
+        json!({"type": "spot", "color": [1, 0.9, 0.7], "intensity": 6, "spot": {"outerConeAngle": 0.6}}),
+        json!({"translation": [1.5, 1.5, 2.0], "rotation": [0.3, -0.3, 0.0, 0.9055]}),
+    );
+    b.camera(0.9, 1.0, [0.0, 0.0, 4.0]);
+    b.write()
+}
+
+/// The films this test renders: (name, scene file, settings).
+fn cases() -> Vec<(String, PathBuf, Settings)> {
+    let mut out = Vec::new();
+    for &(scene, max_depth, sampler, _) in FILMS {
+        let settings = Settings { width: 48, height: 48, max_depth, seed: 7, sampler, ..Settings::default() };
+        out.push((format!("{scene} depth {max_depth} {sampler:?}"), common::asset(scene), settings));
+    }
+    let settings = Settings {
+        width: 48,
+        height: 48,
+        max_depth: 6,
+        seed: 3,
+        environment: Some(Vec3::new(0.2, 0.25, 0.3)),
+        ..Settings::default()
+    };
+    out.push(("features".into(), features_scene(), settings));
+    out
+}
+
+/// Hash of the features scene's CPU film.
+const FEATURES_CPU: u64 = 0xc583d3a2a6cea431;
+
+/// GPU films hash the same only on the same driver: (driver string, hashes in `cases()` order).
+const GPU_FILMS: &[(&str, &[u64])] = &[(
+    "llvmpipe Mesa 22.3.6 (LLVM 15.0.6)",
+    &[
+        0x35cc93596209a723,
+        0x2b67bc6f59bf8950,
+        0xb5e5a3ac501b328e,
+        0xc6f32bafe7df3305,
+        0xcfe66b0f18714efc,
+        0xbf1bac27a228f548,
+        0xef0a9d2b2fb7ddee,
+    ],
+)];
+
+#[test]
+fn gpu_films_of_bundled_scenes_are_unchanged() {
+    let Some(ctx) = common::gpu("gpu_films_of_bundled_scenes_are_unchanged") else { return };
+    let driver = format!("{} {}", ctx.info.driver, ctx.info.driver_info);
+    let Some((_, expected)) = GPU_FILMS.iter().find(|(d, _)| *d == driver) else {
+        eprintln!("SKIPPED gpu_films_of_bundled_scenes_are_unchanged: no hashes recorded for driver '{driver}'");
+        return;
+    };
+    let mut got = Vec::new();
+    for (_, path, settings) in cases() {
+        let film = common::render(&path, &settings, 4, Some(ctx.clone()));
+        got.push(fnv(&film.data));
+    }
+    let shown: Vec<String> = got.iter().map(|h| format!("{h:#018x}")).collect();
+    assert_eq!(&got[..], *expected, "GPU films changed: now [{}]", shown.join(", "));
+}
+
+#[test]
+fn cpu_films_of_bundled_scenes_are_unchanged() {
+    if !(cfg!(target_arch = "x86_64") && cfg!(target_os = "linux") && cfg!(target_env = "gnu")) {
+        eprintln!("SKIPPED cpu_films_of_bundled_scenes_are_unchanged: hashes recorded on x86_64 Linux only");
+        return;
+    }
+    let mut wrong = Vec::new();
+    let expected = FILMS.iter().map(|f| f.3).chain([FEATURES_CPU]);
+    for ((name, path, settings), expected) in cases().into_iter().zip(expected) {
+        let film = common::render(&path, &settings, 4, None);
+        let h = fnv(&film.data);
+        if h != expected {
+            wrong.push(format!("{name}: {h:#018x}, recorded {expected:#018x}"));
+        }
+    }
+    assert!(wrong.is_empty(), "films changed:\n{}", wrong.join("\n"));
+}
