@@ -120,7 +120,10 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
             Settings { width: opts.width, height: opts.height, max_depth: opts.max_depth, ..Settings::default() };
         for &backend in backends {
             progress(&format!("{name}: rendering on {backend:?}"));
-            let mut r = Renderer::with_gpu(packed.clone(), &camera, &settings, backend, ctx.clone())?;
+            let mut r = match (backend, &ctx) {
+                (Backend::Gpu, Some(ctx)) => Renderer::with_context(packed.clone(), &camera, &settings, ctx.clone())?,
+                _ => Renderer::new(packed.clone(), &camera, &settings, backend)?,
+            };
             // One warm-up sample (shader compilation, first-touch allocations) is not timed.
             r.render_samples(0, 1)?;
             let t = Instant::now();

@@ -98,6 +98,21 @@ impl Film {
         self.sample_variance(i) / self.count(i).max(1) as f32
     }
 
+    /// The image: each pixel's mean as linear RGB, row-major, three floats a pixel.
+    pub fn to_rgb32f(&self) -> Vec<f32> {
+        (0..self.pixel_count()).flat_map(|i| self.mean(i).to_array()).collect()
+    }
+
+    /// The variance of each pixel's mean, per channel (row-major, three floats a pixel).
+    pub fn variance(&self) -> Vec<f32> {
+        (0..self.pixel_count()).flat_map(|i| self.variance_of_mean(i).to_array()).collect()
+    }
+
+    /// Samples accumulated in each pixel (row-major).
+    pub fn counts(&self) -> Vec<u32> {
+        (0..self.pixel_count()).map(|i| self.count(i)).collect()
+    }
+
     /// Samples per pixel taken (accumulated or dropped; the same for every pixel).
     pub fn samples(&self) -> u32 {
         (0..self.pixel_count()).map(|i| self.count(i) + self.nonfinite(i)).min().unwrap_or(0)
@@ -107,13 +122,16 @@ impl Film {
         (0..self.pixel_count()).map(|i| self.nonfinite(i) as u64).sum()
     }
 
-    /// Adds another film's samples pixel by pixel, exactly.
-    pub fn merge(&mut self, other: &Film) {
-        self.merge_at(other, 0, 0);
-    }
-
-    /// Adds a film covering the window at (x, y) of this one.
-    pub fn merge_at(&mut self, other: &Film, x: u32, y: u32) {
+    /// Adds a film covering the window at (x, y) of this one, exactly; refuses a window
+    /// outside this film.
+    pub fn merge_at(&mut self, other: &Film, x: u32, y: u32) -> Result<(), String> {
+        let tile = crate::Tile { x, y, width: other.width, height: other.height };
+        if !tile.fits(self.width, self.height) || other.data.len() != other.pixel_count() * WORDS_PER_PIXEL {
+            return Err(format!(
+                "a {}x{} film at {x},{y} does not fit in the {}x{} image",
+                other.width, other.height, self.width, self.height
+            ));
+        }
         for oy in 0..other.height {
             for ox in 0..other.width {
                 let src = other.px((oy * other.width + ox) as usize).to_vec();
@@ -125,10 +143,11 @@ impl Film {
                     p[c] = p[c].wrapping_add(src[c]).wrapping_add(carry as u32);
                     p[8 + c] = (f32::from_bits(p[8 + c]) + f32::from_bits(src[8 + c])).to_bits();
                 }
-                p[3] += src[3];
-                p[7] += src[7];
+                p[3] = p[3].wrapping_add(src[3]);
+                p[7] = p[7].wrapping_add(src[7]);
             }
         }
+        Ok(())
     }
 }
 
@@ -152,7 +171,7 @@ mod tests {
         let (mut a, mut b) = (Film::new(1, 1), Film::new(1, 1));
         samples[..23].iter().for_each(|s| a.add_sample(0, *s));
         samples[23..].iter().for_each(|s| b.add_sample(0, *s));
-        b.merge(&a);
+        b.merge_at(&a, 0, 0).unwrap();
         assert_eq!(whole.data[..8], b.data[..8], "sums and counts merge bit-exactly in any order");
         assert_eq!(whole.count(0), 64);
         let mean: Vec3 = samples.iter().sum::<Vec3>() / 64.0;

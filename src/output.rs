@@ -29,9 +29,7 @@ pub fn check_output(path: &Path) -> Result<Format, Error> {
     if path.is_dir() {
         return Err(Error::Input(format!("{}: is a directory", path.display())));
     }
-    let probe = temp_path(path);
-    std::fs::write(&probe, b"").map_err(|e| Error::Input(format!("{}: cannot write output: {e}", path.display())))?;
-    let _ = std::fs::remove_file(&probe);
+    check_writable(path)?;
     Ok(format)
 }
 
@@ -144,6 +142,7 @@ pub fn read_film(path: &Path) -> Result<(Film, Job), crate::Error> {
         }
         _ => return Err(fail("not a veach render (no film metadata)".into())),
     };
+    job.validate().map_err(|e| fail(format!("invalid render job in the veach metadata: {e}")))?;
     let (w, h) = (layer.size.width(), layer.size.height());
     let window = job.window();
     if (w, h) != (window.width as usize, window.height as usize) {
@@ -168,11 +167,38 @@ pub fn read_film(path: &Path) -> Result<(Film, Job), crate::Error> {
             film.data[i * WORDS_PER_PIXEL + k] = word;
         }
     }
+    // Every pixel took the same samples, at most the job's: anything else is a damaged file.
+    let counts = |i: usize| film.count(i) as u64 + film.nonfinite(i) as u64;
+    let first = counts(0);
+    if (0..film.pixel_count()).any(|i| counts(i) != first) || first > job.spp() as u64 {
+        return Err(fail(format!(
+            "the film's sample counts disagree with each other or exceed the job's {} spp",
+            job.spp()
+        )));
+    }
     Ok((film, job))
 }
 
 pub fn write_png(img: &image::RgbImage, path: &Path) -> Result<(), Error> {
     save_atomic(path, |tmp| img.save_with_format(tmp, image::ImageFormat::Png))
+}
+
+/// Fails early when `path` cannot be written, leaving nothing behind.
+pub fn check_writable(path: &Path) -> Result<(), Error> {
+    let probe = temp_path(path);
+    std::fs::write(&probe, b"").map_err(|e| Error::io(path, "cannot write", e))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// Writes `bytes` to `path` through a temporary file renamed into place.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    let tmp = temp_path(path);
+    std::fs::write(&tmp, bytes).map_err(|e| Error::io(path, "cannot write", e))?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        Error::io(path, "cannot write", e)
+    })
 }
 
 fn save_atomic(path: &Path, save: impl FnOnce(&Path) -> image::ImageResult<()>) -> Result<(), Error> {

@@ -1,8 +1,9 @@
 //! Per-sample render parameters: the uniform block of `shaders/common.wgsl` (`Params`),
 //! read by both backends.
 
-use crate::Strategy;
+use crate::packed::PackedScene;
 use crate::scene::Camera;
+use crate::settings::{Settings, Tile};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
@@ -43,7 +44,7 @@ pub struct Params {
     pub punctual_count: u32,
     /// First instance record in the node array (when the scene has instances).
     pub instance_base: u32,
-    /// How samples are generated: `cpu::sampler::SAMPLER_INDEPENDENT` or `SAMPLER_SOBOL`.
+    /// How samples are generated: a `SamplerKind` id.
     pub sampler: u32,
     pub pad: [u32; 2],
 }
@@ -64,19 +65,12 @@ pub fn env_select_probability(environment: Vec3, has_map: bool, map_total: f32, 
 }
 
 impl Params {
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        camera: &Camera,
-        image: (u32, u32),
-        tile: crate::Tile,
-        seed: u32,
-        max_depth: u32,
-        strategy: Strategy,
-        environment: Vec3,
-        scene: &crate::packed::PackedScene,
-    ) -> Params {
+    /// The parameters of `settings` for `camera` over the window `tile`, before the lens is
+    /// set up (a pinhole).
+    pub fn new(camera: &Camera, settings: &Settings, tile: Tile, scene: &PackedScene) -> Params {
         let light_count = scene.lights.len() as u32;
-        let (w, h) = image;
+        let (w, h) = (settings.width, settings.height);
+        let environment = scene.environment;
         let tan_half = (0.5 * camera.yfov).tan();
         let aspect = w as f32 / h as f32;
         Params {
@@ -87,10 +81,10 @@ impl Params {
             cam_up: (camera.up * tan_half).into(),
             sample_index: 0,
             cam_forward: camera.forward.into(),
-            seed,
+            seed: settings.seed,
             environment: environment.into(),
-            max_depth,
-            strategy: strategy as u32,
+            max_depth: settings.max_depth,
+            strategy: settings.strategy as u32,
             light_count,
             rr_depth: RR_DEPTH,
             image_width: w,
@@ -107,7 +101,7 @@ impl Params {
             punctual_base: scene.punctual_base,
             punctual_count: scene.punctual_count,
             instance_base: scene.instance_base,
-            sampler: crate::cpu::sampler::SAMPLER_SOBOL,
+            sampler: settings.sampler as u32,
             pad: [0; 2],
         }
     }

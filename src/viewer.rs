@@ -6,7 +6,7 @@ use crate::gpu::{GpuContext, shaders};
 use crate::packed::PackedScene;
 use crate::scene::{Camera, Scene};
 use crate::tonemap::Tonemap;
-use crate::{Backend, Error, Renderer, Settings, Strategy};
+use crate::{Error, Renderer, Settings, Strategy};
 use eframe::egui;
 use eframe::egui_wgpu;
 use eframe::wgpu;
@@ -47,7 +47,7 @@ pub fn run(options: ViewOptions) -> Result<(), Error> {
         }),
     )
     .map_err(|e| Error::Gpu(format!("cannot open the viewer window: {e}")))?;
-    result.lock().map(|r| r.clone()).unwrap_or(Ok(()))
+    result.lock().map(|mut r| std::mem::replace(&mut *r, Ok(()))).unwrap_or(Ok(()))
 }
 
 /// Mouse and keyboard camera: orbit about a target, pan, zoom, fly.
@@ -105,6 +105,8 @@ struct Viewer {
     exposure: f32,
     tonemap: Tonemap,
     env_strength: f32,
+    /// The strength the renderer's environment was built with (None: rebuild it).
+    env_applied: Option<f32>,
     paused: bool,
     target_spp: u32,
     samples: u32,
@@ -144,6 +146,7 @@ impl Viewer {
             exposure: 0.0,
             tonemap: Tonemap::Aces,
             env_strength: 1.0,
+            env_applied: None,
             paused: false,
             target_spp: 4096,
             samples: 0,
@@ -176,11 +179,11 @@ impl Viewer {
         if matches!(ext.as_deref(), Some("hdr") | Some("exr")) {
             match crate::scene::EnvironmentMap::load(path) {
                 Ok(map) => {
+                    // A new sky: the renderer keeps its BVH and geometry.
                     if let Some(scene) = &mut self.scene {
-                        scene.environment_map = Some(map);
-                        scene.environment = Vec3::ONE;
-                        let scene = scene.clone();
-                        self.install(scene, None);
+                        scene.environment = crate::Environment::map(map, Vec3::ONE);
+                        self.env_applied = None;
+                        self.dirty = true;
                     }
                 }
                 Err(e) => self.error = Some(e.to_string()),
@@ -188,17 +191,17 @@ impl Viewer {
             return;
         }
         match crate::load(path, None) {
-            Ok((mut scene, camera)) => {
+            Ok(crate::Loaded { mut scene, camera, warnings }) => {
+                self.status = warnings.join("; ");
                 if let Some(map) = &self.options.env {
                     match crate::scene::EnvironmentMap::load(map) {
                         Ok(m) => {
-                            scene.environment_map = Some(m);
-                            scene.environment = self.options.env_color.unwrap_or(Vec3::ONE);
+                            scene.environment = crate::Environment::map(m, self.options.env_color.unwrap_or(Vec3::ONE));
                         }
                         Err(e) => self.error = Some(e.to_string()),
                     }
                 } else if let Some(c) = self.options.env_color {
-                    scene.environment = c;
+                    scene.environment = crate::Environment::constant(c);
                 }
                 self.scene_path = Some(path.to_path_buf());
                 self.install(scene, Some(camera));
@@ -217,7 +220,8 @@ impl Viewer {
         }
         let packed = PackedScene::new(&scene);
         let ctx = GpuContext::from_device(self.rs.device.clone(), self.rs.queue.clone(), self.rs.adapter.get_info());
-        match Renderer::with_gpu(packed, &self.orbit.camera(), &self.settings, Backend::Gpu, Some(ctx)) {
+        self.env_applied = Some(1.0);
+        match Renderer::with_context(packed, &self.orbit.camera(), &self.settings, ctx) {
             Ok(r) => {
                 self.renderer = Some(r);
                 self.scene = Some(scene);
@@ -228,8 +232,10 @@ impl Viewer {
         }
     }
 
-    fn environment(&self) -> Option<Vec3> {
-        self.scene.as_ref().map(|s| s.environment * self.env_strength)
+    /// The scene's environment scaled by the strength slider.
+    fn environment(&self) -> Option<crate::Environment> {
+        let env = &self.scene.as_ref()?.environment;
+        Some(crate::Environment { map: env.map.clone(), radiance: env.radiance * self.env_strength })
     }
 
     /// Restart accumulation at the size the image area wants.
@@ -237,12 +243,17 @@ impl Viewer {
         let scale = self.scale * if self.moving { self.scale_moving } else { 1.0 };
         self.settings.width = ((width as f32 * scale) as u32).max(8);
         self.settings.height = ((height as f32 * scale) as u32).max(8);
-        self.settings.environment = self.environment();
         let camera = self.orbit.camera();
-        if let Some(r) = &mut self.renderer
-            && let Err(e) = r.reset(&camera, &self.settings)
-        {
-            self.error = Some(e.to_string());
+        let environment = (self.env_applied != Some(self.env_strength)).then(|| self.environment()).flatten();
+        if let Some(r) = &mut self.renderer {
+            let mut result = r.reset(&camera, &self.settings);
+            if let (Ok(()), Some(env)) = (&result, environment) {
+                result = r.set_environment(&camera, &env);
+                self.env_applied = Some(self.env_strength);
+            }
+            if let Err(e) = result {
+                self.error = Some(e.to_string());
+            }
         }
         self.samples = 0;
         self.row = 0;
@@ -270,20 +281,12 @@ impl Viewer {
             && let (Some(p), Some(r)) = (response.interact_pointer_pos(), &self.renderer)
         {
             let uv = (p - response.rect.min) / response.rect.size();
-            let params = crate::params::Params { aperture: 0.0, ..*r.params() };
             let pixel = glam::UVec2::new(
                 (uv.x * self.settings.width as f32).max(0.0) as u32,
                 (uv.y * self.settings.height as f32).max(0.0) as u32,
             );
-            let ray = crate::cpu::camera::generate_ray(
-                &params,
-                pixel,
-                glam::Vec2::splat(0.5),
-                &mut crate::cpu::sampler::sampler_init(0, 0, 0, 0),
-            );
-            let hit = crate::cpu::bvh::intersect_closest(r.scene(), &ray);
-            if hit.tri != crate::cpu::bvh::NO_HIT {
-                self.settings.focus_distance = Some(hit.t * ray.dir.dot(Vec3::from(params.cam_forward)));
+            if let Some(depth) = r.pick_depth(pixel) {
+                self.settings.focus_distance = Some(depth);
                 self.status = format!("focus distance {:.4}", self.settings.focus_distance.unwrap_or(0.0));
                 changed = true;
             }
@@ -672,7 +675,7 @@ mod tests {
     #[test]
     fn orbit_reproduces_the_camera_it_starts_from() {
         // The viewer's first frame uses the same camera as `veach render`.
-        let (scene, camera) =
+        let crate::Loaded { scene, camera, .. } =
             crate::load(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/cornell-box.gltf")), None)
                 .expect("asset");
         let b = scene.bounds();

@@ -7,7 +7,7 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 use veach::cpu::bsdf::{bsdf_eval, bsdf_pdf, bsdf_sample};
-use veach::packed::{PackedMaterial, pack_material};
+use veach::packed::{Material as PackedMaterial, pack_material};
 use veach::scene::Material;
 
 struct Lcg(u64);

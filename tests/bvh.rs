@@ -73,7 +73,7 @@ fn bvh_closest_hit_equals_brute_force() {
     let mut rng = Lcg(7);
     check(&soup(3000, &mut rng), 10_000, &mut rng);
     for name in ["cornell-box.gltf", "furnace-a080.gltf", "veach-mis.gltf"] {
-        let (scene, _) = veach::load(&common::asset(name), None).expect("asset loads");
+        let (scene, _) = common::load_pair(&common::asset(name), None).expect("asset loads");
         check(&scene, 10_000, &mut rng);
     }
 }
@@ -93,7 +93,7 @@ fn bvh_finds_hits_of_axis_parallel_rays() {
         d.normalize()
     };
     check_with(&soup(3000, &mut rng), 10_000, &mut rng, axis_parallel);
-    let (scene, _) = veach::load(&common::asset("cornell-box.gltf"), None).expect("asset loads");
+    let (scene, _) = common::load_pair(&common::asset("cornell-box.gltf"), None).expect("asset loads");
     check_with(&scene, 10_000, &mut rng, axis_parallel);
 }
 

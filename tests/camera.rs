@@ -5,17 +5,17 @@ mod common;
 
 use common::*;
 use glam::{UVec2, Vec2, Vec3};
+use veach::Tile;
 use veach::cpu::camera::{autofocus, generate_ray};
 use veach::cpu::sampler::{SAMPLER_SOBOL, sampler_init};
 use veach::packed::PackedScene;
 use veach::params::Params;
-use veach::{Strategy, Tile};
 
 fn params(aperture: f32, focus: f32) -> (PackedScene, Params) {
-    let (scene, camera) = veach::load(&asset("cornell-box.gltf"), None).unwrap();
+    let (scene, camera) = common::load_pair(&asset("cornell-box.gltf"), None).unwrap();
     let packed = PackedScene::new(&scene);
     let tile = Tile { x: 0, y: 0, width: 64, height: 48 };
-    let mut p = Params::new(&camera, (64, 48), tile, 0, 8, Strategy::MisPower, Vec3::ZERO, &packed);
+    let mut p = Params::new(&camera, &veach::Settings { width: 64, height: 48, ..Default::default() }, tile, &packed);
     p.aperture = aperture;
     p.focus_distance = focus;
     (packed, p)

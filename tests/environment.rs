@@ -6,11 +6,11 @@ mod common;
 use common::*;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+use veach::Tile;
 use veach::cpu::environment::{env_direction, environment_pdf, environment_radiance, sample_environment};
 use veach::packed::PackedScene;
 use veach::params::Params;
 use veach::scene::{EnvironmentMap, Scene};
-use veach::{Strategy, Tile};
 
 /// A sky: a dim gradient, a bright small sun, and a black band (pdf 0 there).
 fn sky(w: u32, h: u32) -> EnvironmentMap {
@@ -32,11 +32,11 @@ fn sky(w: u32, h: u32) -> EnvironmentMap {
 }
 
 fn setup(map: EnvironmentMap) -> (PackedScene, Params) {
-    let scene = Scene { environment: Vec3::ONE, environment_map: Some(map), ..Default::default() };
+    let scene = Scene { environment: veach::Environment::map(map, Vec3::ONE), ..Default::default() };
     let packed = PackedScene::new(&scene);
     let camera = scene.camera(None).expect("default camera");
     let tile = Tile { x: 0, y: 0, width: 4, height: 4 };
-    let params = Params::new(&camera, (4, 4), tile, 0, 8, Strategy::MisPower, Vec3::ONE, &packed);
+    let params = Params::new(&camera, &veach::Settings { width: 4, height: 4, ..Default::default() }, tile, &packed);
     (packed, params)
 }
 
@@ -103,12 +103,10 @@ fn sampling_estimates_the_integral_of_the_map() {
 }
 
 fn furnace_with_map(map: EnvironmentMap, ctx: Option<veach::gpu::GpuContext>, seed: u32) -> veach::film::Film {
-    let (mut scene, camera) = veach::load(&asset("furnace-a080.gltf"), None).expect("scene");
-    scene.environment = Vec3::ONE;
-    scene.environment_map = Some(map);
+    let (mut scene, camera) = common::load_pair(&asset("furnace-a080.gltf"), None).expect("scene");
+    scene.environment = veach::Environment::map(map, Vec3::ONE);
     let packed = PackedScene::new(&scene);
-    let backend = if ctx.is_some() { veach::Backend::Gpu } else { veach::Backend::Cpu };
-    let mut r = veach::Renderer::with_gpu(packed, &camera, &settings(48, 8, seed), backend, ctx).expect("renderer");
+    let mut r = common::renderer(packed, &camera, &settings(48, 8, seed), ctx).expect("renderer");
     r.render_samples(0, 64).expect("render");
     r.film().expect("film")
 }

@@ -48,20 +48,10 @@ fn four_estimators_agree_in_the_mean() {
 
 /// Which plate (material 1..=4 of the Veach scene) each pixel's centre sees, if any.
 fn plate_masks() -> Vec<Vec<usize>> {
-    let (scene, camera) = veach::load(&asset("veach-mis.gltf"), None).expect("scene");
+    let (scene, camera) = common::load_pair(&asset("veach-mis.gltf"), None).expect("scene");
     let packed = veach::packed::PackedScene::new(&scene);
     let s = settings(64, 2, 0);
-    let params = veach::params::Params::new(
-        &camera,
-        (64, 64),
-        veach::Tile { x: 0, y: 0, width: 64, height: 64 },
-        0,
-        2,
-        Strategy::MisPower,
-        Vec3::ZERO,
-        &packed,
-    );
-    let _ = s;
+    let params = veach::params::Params::new(&camera, &s, s.window(), &packed);
     let mut plates = vec![Vec::new(); 4];
     for y in 0..64 {
         for x in 0..64 {
@@ -69,7 +59,7 @@ fn plate_masks() -> Vec<Vec<usize>> {
                 &params,
                 UVec2::new(x, y),
                 Vec2::splat(0.5),
-                &mut veach::cpu::sampler::sampler_init(0, 0, 0, 0),
+                &mut veach::cpu::sampler::sampler_init(veach::cpu::sampler::SAMPLER_INDEPENDENT, 0, 0, 0),
             );
             let hit = intersect_closest(&packed, &ray);
             if hit.tri != NO_HIT {

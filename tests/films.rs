@@ -9,7 +9,6 @@
 mod common;
 
 use common::build::{GltfBuilder, MeshData};
-use glam::Vec3;
 use serde_json::json;
 use std::path::PathBuf;
 use veach::Settings;
@@ -86,7 +85,7 @@ fn cases() -> Vec<(String, PathBuf, Settings)> {
         height: 48,
         max_depth: 6,
         seed: 3,
-        environment: Some(Vec3::new(0.2, 0.25, 0.3)),
+        env_color: Some([0.2, 0.25, 0.3]),
         ..Settings::default()
     };
     out.push(("features".into(), features_scene(), settings));

@@ -112,7 +112,7 @@ fn degenerate_empty_and_huge_scenes_render_finite_images() {
     let huge = [-1e30, -1e30, 0.0, 1e30, -1e30, 0.0, 0.0, 1e30, 0.0];
     for bytes in [triangle_gltf(&huge, &[0, 1, 2], None), triangle_gltf(&zero, &[0, 1, 2], None)] {
         let mut scene = load_bytes(&bytes, None).expect("loads");
-        scene.environment = Vec3::splat(0.5);
+        scene.environment = veach::Environment::constant(Vec3::splat(0.5));
         let camera = scene.camera(None).expect("camera");
         let packed = veach::packed::PackedScene::new(&scene);
         let mut r = veach::Renderer::new(packed, &camera, &common::settings(16, 8, 0), veach::Backend::Cpu).unwrap();

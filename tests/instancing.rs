@@ -11,7 +11,7 @@ use glam::{Quat, Vec3};
 use serde_json::json;
 use std::path::PathBuf;
 use veach::packed::PackedScene;
-use veach::{Backend, Renderer, Settings};
+use veach::{Backend, Settings};
 
 /// A unit cube centred at the origin with flat faces (24 vertices), wedge-cut so that a
 /// mirror image differs: the +x face is tilted.
@@ -95,10 +95,10 @@ fn placements() -> Vec<serde_json::Value> {
     ]
 }
 
-fn render(path: &std::path::Path, backend: Backend, ctx: Option<veach::gpu::GpuContext>) -> veach::film::Film {
-    let (scene, camera) = veach::load(path, None).unwrap();
+fn render(path: &std::path::Path, ctx: Option<veach::gpu::GpuContext>) -> veach::film::Film {
+    let (scene, camera) = common::load_pair(path, None).unwrap();
     let settings = Settings { width: 48, height: 48, max_depth: 8, ..Settings::default() };
-    let mut r = Renderer::with_gpu(PackedScene::new(&scene), &camera, &settings, backend, ctx).unwrap();
+    let mut r = common::renderer(PackedScene::new(&scene), &camera, &settings, ctx).unwrap();
     r.render_samples(0, 96).unwrap();
     r.film().unwrap()
 }
@@ -107,9 +107,9 @@ fn render(path: &std::path::Path, backend: Backend, ctx: Option<veach::gpu::GpuC
 fn instanced_meshes_render_like_flattened_copies() {
     let shared = scene("shared", &placements(), true);
     let copies = scene("copies", &placements(), false);
-    let (s, _) = veach::load(&shared, None).unwrap();
+    let (s, _) = common::load_pair(&shared, None).unwrap();
     assert_eq!((s.meshes.len(), s.instances.len()), (1, 6));
-    let (c, _) = veach::load(&copies, None).unwrap();
+    let (c, _) = common::load_pair(&copies, None).unwrap();
     assert_eq!((c.meshes.len(), c.instances.len()), (0, 0));
     assert_eq!(s.drawn_triangle_count(), c.triangles.len());
 
@@ -119,8 +119,8 @@ fn instanced_meshes_render_like_flattened_copies() {
         runs.push((Backend::Gpu, ctx.clone()));
     }
     for (backend, ctx) in runs {
-        let (am, av) = film_stats(&render(&shared, backend, ctx.clone()));
-        let (bm, bv) = film_stats(&render(&copies, backend, ctx));
+        let (am, av) = film_stats(&render(&shared, ctx.clone()));
+        let (bm, bv) = film_stats(&render(&copies, ctx));
         let a = agreement(&am, &av, &bm, &bv);
         eprintln!("{backend:?}: {a:?}");
         assert!(a.mean_z.abs().max_element() < 5.0, "{backend:?}: instanced vs flattened {a:?}");
@@ -135,7 +135,7 @@ fn instances_cost_a_transform_not_a_mesh() {
     let geometry = |n: usize| {
         let p: Vec<serde_json::Value> =
             (0..n).map(|i| json!({"translation": [i as f32 * 1.5 - 10.0, 0.5, (i / 10) as f32 * -1.5]})).collect();
-        let (scene, _) = veach::load(&scene(&format!("n{n}"), &p, true), None).unwrap();
+        let (scene, _) = common::load_pair(&scene(&format!("n{n}"), &p, true), None).unwrap();
         let packed = PackedScene::new(&scene);
         (std::mem::size_of_val(&packed.nodes[..])
             + std::mem::size_of_val(&packed.triangles[..])

@@ -28,14 +28,14 @@ fn srgb_to_linear(c: u8) -> f32 {
 
 /// Renders on the CPU and, when available, on the GPU: (backend name, film) pairs.
 fn render_both(path: &Path, settings: &Settings, spp: u32, test: &str) -> Vec<(&'static str, Film)> {
-    let (scene, camera) = veach::load(path, None).unwrap_or_else(|e| panic!("{test}: {e}"));
+    let (scene, camera) = common::load_pair(path, None).unwrap_or_else(|e| panic!("{test}: {e}"));
     let packed = veach::packed::PackedScene::new(&scene);
     let mut out = Vec::new();
     let mut cpu = Renderer::new(packed.clone(), &camera, settings, Backend::Cpu).unwrap();
     cpu.render_samples(0, spp).unwrap();
     out.push(("cpu", cpu.film().unwrap()));
     if let Some(ctx) = gpu(test) {
-        let mut g = Renderer::with_gpu(packed, &camera, settings, Backend::Gpu, Some(ctx)).unwrap();
+        let mut g = common::renderer(packed, &camera, settings, Some(ctx)).unwrap();
         g.render_samples(0, spp).unwrap();
         out.push(("gpu", g.film().unwrap()));
     }
@@ -43,7 +43,7 @@ fn render_both(path: &Path, settings: &Settings, spp: u32, test: &str) -> Vec<(&
 }
 
 fn settings(width: u32, height: u32, max_depth: u32) -> Settings {
-    Settings { width, height, max_depth, environment: Some(Vec3::ZERO), ..Settings::default() }
+    Settings { width, height, max_depth, env_color: Some([0.0; 3]), ..Settings::default() }
 }
 
 /// A camera at z = `d` looking down −z whose view spans y ∈ [−half, half] on the plane z = 0.
@@ -327,7 +327,7 @@ fn glass_in_a_furnace_neither_creates_nor_loses_energy() {
     // the energy of single-scattering microfacets, never gain. Unlimited depth (roulette).
     for (roughness, min_mean) in [(0.0, 0.995), (0.3, 0.93)] {
         let path = glass_furnace(roughness);
-        let s = Settings { width: 48, height: 48, max_depth: 0, environment: Some(Vec3::ONE), ..Settings::default() };
+        let s = Settings { width: 48, height: 48, max_depth: 0, env_color: Some([1.0; 3]), ..Settings::default() };
         let films = render_both(&path, &s, 32, "glass furnace");
         for (backend, film) in &films {
             let (mean, var) = film_stats(film);

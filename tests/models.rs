@@ -4,9 +4,8 @@
 
 mod common;
 
-use glam::Vec3;
 use std::path::PathBuf;
-use veach::{Backend, Renderer, Settings};
+use veach::Settings;
 
 fn models_dir() -> Option<PathBuf> {
     let d = common::root().join("../shared/models");
@@ -42,16 +41,15 @@ fn every_shared_model_renders_finite_and_plausible() {
     assert!(files.len() >= 8, "expected the shared models, found {files:?}");
     let ctx = common::gpu("every_shared_model_renders_finite_and_plausible");
     for path in files {
-        let (scene, camera) = veach::load(&path, None).unwrap_or_else(|e| panic!("{e}"));
+        let (scene, camera) = common::load_pair(&path, None).unwrap_or_else(|e| panic!("{e}"));
         for w in &scene.warnings {
             eprintln!("{}: warning: {w}", path.display());
         }
         let packed = veach::packed::PackedScene::new(&scene);
         // A white sky, so that models without lights are seen.
         let settings =
-            Settings { width: 64, height: 64, max_depth: 6, environment: Some(Vec3::ONE), ..Settings::default() };
-        let backend = if ctx.is_some() { Backend::Gpu } else { Backend::Cpu };
-        let mut r = Renderer::with_gpu(packed, &camera, &settings, backend, ctx.clone()).unwrap();
+            Settings { width: 64, height: 64, max_depth: 6, env_color: Some([1.0; 3]), ..Settings::default() };
+        let mut r = common::renderer(packed, &camera, &settings, ctx.clone()).unwrap();
         r.render_samples(0, 4).unwrap();
         let film = r.film().unwrap();
         assert_eq!(film.nonfinite_samples(), 0, "{}: non-finite samples", path.display());
@@ -72,7 +70,7 @@ fn every_shared_model_renders_finite_and_plausible() {
 #[test]
 fn emissive_strength_doubles_per_step() {
     let Some(dir) = models_dir() else { return };
-    let (scene, _) = veach::load(&dir.join("EmissiveStrengthTest/EmissiveStrengthTest.glb"), None).unwrap();
+    let (scene, _) = common::load_pair(&dir.join("EmissiveStrengthTest/EmissiveStrengthTest.glb"), None).unwrap();
     let mut radiance: Vec<f32> =
         scene.materials.iter().filter(|m| m.is_emissive()).map(|m| m.emission.max_element()).collect();
     radiance.sort_by(f32::total_cmp);
@@ -86,7 +84,7 @@ fn emissive_strength_doubles_per_step() {
 #[test]
 fn flight_helmet_keeps_its_textures_and_mirrored_tangents() {
     let Some(dir) = models_dir() else { return };
-    let (scene, _) = veach::load(&dir.join("FlightHelmet/FlightHelmet.gltf"), None).unwrap();
+    let (scene, _) = common::load_pair(&dir.join("FlightHelmet/FlightHelmet.gltf"), None).unwrap();
     assert_eq!(scene.textures.len(), 15);
     assert!(scene.materials.iter().any(|m| m.normal_texture.is_some()));
     let mirrored = scene.triangles.iter().filter(|t| t.tangents[0].w < 0.0).count();

@@ -5,13 +5,13 @@
 
 mod common;
 
-use veach::{Backend, Renderer, Settings};
+use veach::Settings;
 
 fn render(path: &std::path::Path, ctx: veach::gpu::GpuContext) -> veach::film::Film {
-    let (scene, camera) = veach::load(path, None).unwrap();
+    let (scene, camera) = common::load_pair(path, None).unwrap();
     let packed = veach::packed::PackedScene::new(&scene);
     let settings = Settings { width: 48, height: 48, max_depth: 6, ..Settings::default() };
-    let mut r = Renderer::with_gpu(packed, &camera, &settings, Backend::Gpu, Some(ctx)).unwrap();
+    let mut r = common::renderer(packed, &camera, &settings, Some(ctx)).unwrap();
     r.render_samples(0, 4).unwrap();
     r.film().unwrap()
 }

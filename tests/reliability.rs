@@ -126,7 +126,7 @@ fn sigint_keeps_the_work_and_resume_finishes_it_exactly() {
 #[test]
 fn non_finite_samples_are_dropped_and_counted() {
     // A material that produces NaN (the loader would sanitise it; inject it after loading).
-    let (mut scene, camera) = veach::load(&common::asset("cornell-box.gltf"), None).unwrap();
+    let (mut scene, camera) = common::load_pair(&common::asset("cornell-box.gltf"), None).unwrap();
     scene.materials[0].base_color = Vec3::new(f32::NAN, 0.5, 0.5);
     let mut renderers = vec![veach::Backend::Cpu];
     if common::gpu("non_finite_samples_are_dropped_and_counted").is_some() {

@@ -11,10 +11,9 @@ fn resident_bytes() -> u64 {
 #[ignore = "soak test: about a minute or more on lavapipe"]
 fn hundred_thousand_dispatches_do_not_grow_memory() {
     let Some(ctx) = common::gpu("soak") else { return };
-    let (scene, camera) = veach::load(&common::asset("cornell-box.gltf"), None).unwrap();
+    let (scene, camera) = common::load_pair(&common::asset("cornell-box.gltf"), None).unwrap();
     let packed = veach::packed::PackedScene::new(&scene);
-    let mut r =
-        veach::Renderer::with_gpu(packed, &camera, &common::settings(8, 8, 0), veach::Backend::Gpu, Some(ctx)).unwrap();
+    let mut r = common::renderer(packed, &camera, &common::settings(8, 8, 0), Some(ctx)).unwrap();
     r.render_samples(0, 10_000).unwrap();
     let after_warmup = resident_bytes();
     let t = std::time::Instant::now();

@@ -53,7 +53,7 @@ fn viewer_screenshot_shows_the_render_and_the_panel() {
 /// is bit for bit the film `veach render` builds from whole-image dispatches.
 #[test]
 fn viewer_bands_build_the_same_film_as_render() {
-    let (scene, camera) = veach::load(&common::asset("cornell-box.gltf"), None).unwrap();
+    let (scene, camera) = common::load_pair(&common::asset("cornell-box.gltf"), None).unwrap();
     let mut backends = vec![None];
     if let Some(ctx) = common::gpu("viewer_bands_build_the_same_film_as_render") {
         backends.push(Some(ctx));
@@ -64,10 +64,10 @@ fn viewer_bands_build_the_same_film_as_render() {
         let packed = veach::packed::PackedScene::new(&scene);
         let mut whole = veach::Renderer::new(packed.clone(), &camera, &s, veach::Backend::Cpu).unwrap();
         if backend == veach::Backend::Gpu {
-            whole = veach::Renderer::with_gpu(packed.clone(), &camera, &s, backend, common::gpu("bands")).unwrap();
+            whole = common::renderer(packed.clone(), &camera, &s, common::gpu("bands")).unwrap();
         }
         whole.render_samples(0, 3).unwrap();
-        let mut bands = veach::Renderer::with_gpu(packed, &camera, &s, backend, ctx).unwrap();
+        let mut bands = common::renderer(packed, &camera, &s, ctx).unwrap();
         for sample in 0..3 {
             for (y0, rows) in [(0, 8), (8, 16), (24, 8)] {
                 bands.render_rows(sample, y0, rows).unwrap();

@@ -3,7 +3,7 @@
 
 use super::microfacet::{ggx_d, ggx_g1, ggx_g2, ggx_reflection_pdf, ggx_sample_vndf};
 use super::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
-use crate::packed::{PackedMaterial, luminance};
+use crate::packed::{Material, luminance};
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::FRAC_1_PI;
 
@@ -38,7 +38,7 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 }
 
 #[inline]
-pub fn dielectric_fresnel(m: &PackedMaterial, cos_theta: f32, eta: f32) -> Vec3 {
+pub fn dielectric_fresnel(m: &Material, cos_theta: f32, eta: f32) -> Vec3 {
     if m.transmission > 0.0 {
         return Vec3::splat(fresnel_dielectric(cos_theta, eta));
     }
@@ -46,25 +46,25 @@ pub fn dielectric_fresnel(m: &PackedMaterial, cos_theta: f32, eta: f32) -> Vec3 
 }
 
 #[inline]
-pub fn bsdf_fresnel(m: &PackedMaterial, cos_theta: f32, eta: f32) -> Vec3 {
+pub fn bsdf_fresnel(m: &Material, cos_theta: f32, eta: f32) -> Vec3 {
     let metal = fresnel_schlick(m.base_color.into(), Vec3::ONE, cos_theta);
     dielectric_fresnel(m, cos_theta, eta).lerp(metal, m.metallic)
 }
 
 #[inline]
-pub fn diffuse_albedo(m: &PackedMaterial, cos_o: f32, eta: f32) -> Vec3 {
+pub fn diffuse_albedo(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
     let f = dielectric_fresnel(m, cos_o, eta);
     (1.0 - m.metallic) * (1.0 - m.transmission) * Vec3::from(m.base_color) * (Vec3::ONE - f)
 }
 
 #[inline]
-pub fn transmission_albedo(m: &PackedMaterial, cos_o: f32, eta: f32) -> Vec3 {
+pub fn transmission_albedo(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
     let f = dielectric_fresnel(m, cos_o, eta);
     (1.0 - m.metallic) * m.transmission * Vec3::from(m.base_color) * (Vec3::ONE - f)
 }
 
 #[inline]
-pub fn lobe_probabilities(m: &PackedMaterial, cos_o: f32, eta: f32) -> Vec3 {
+pub fn lobe_probabilities(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
     let mut wt = luminance(transmission_albedo(m, cos_o, eta));
     if m.roughness * m.roughness >= DELTA_ALPHA {
         wt = wt.max(0.1 * (1.0 - m.metallic) * m.transmission * luminance(m.base_color.into()));
@@ -104,7 +104,7 @@ pub fn refract_dir(wo: Vec3, n: Vec3, eta: f32) -> Vec4 {
     (-wo / eta + (cos_i / eta - cos_t) * n).extend(1.0)
 }
 
-pub fn bsdf_eval(m: &PackedMaterial, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
+pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
     let alpha = m.roughness * m.roughness;
     if wo.z <= 0.0 || wi.z == 0.0 {
         return Vec3::ZERO;
@@ -133,7 +133,7 @@ pub fn bsdf_eval(m: &PackedMaterial, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
     f
 }
 
-pub fn bsdf_pdf(m: &PackedMaterial, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
     if wo.z <= 0.0 || wi.z == 0.0 {
         return 0.0;
     }
@@ -158,7 +158,7 @@ pub fn bsdf_pdf(m: &PackedMaterial, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
     pdf
 }
 
-pub fn bsdf_sample(m: &PackedMaterial, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
+pub fn bsdf_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
     let none = BsdfSample { wi: Vec3::Z, weight: Vec3::ZERO, pdf: 0.0, delta: false };
     if wo.z <= 0.0 {
         return none;

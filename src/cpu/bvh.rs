@@ -2,7 +2,7 @@
 
 use super::instance::{load_instance, transform_dir, transform_point};
 use super::material::alpha_passes;
-use crate::packed::{BvhNode, CwNode, PackedScene, PackedTriangle, TRI_ALPHA};
+use crate::packed::{BvhNode, CwNode, PackedScene, TRI_ALPHA, Triangle};
 use glam::{IVec3, UVec2, UVec3, Vec3, Vec3A, Vec4};
 
 pub const NO_HIT: u32 = u32::MAX;
@@ -26,7 +26,7 @@ pub struct Hit {
     pub instance: u32,
 }
 
-pub fn intersect_triangle(ray: &Ray, tri: &PackedTriangle) -> Vec3 {
+pub fn intersect_triangle(ray: &Ray, tri: &Triangle) -> Vec3 {
     let (p0, e1, e2) = (Vec3::from(tri.p0), Vec3::from(tri.e1), Vec3::from(tri.e2));
     let pvec = ray.dir.cross(e2);
     let det = e1.dot(pvec);
@@ -146,7 +146,7 @@ pub fn octant_inv4(dir: Vec3) -> u32 {
 }
 
 pub fn trace_blas(scene: &PackedScene, ray: &Ray, root: u32, best: Hit, any_hit: bool, instance: u32) -> Hit {
-    let triangles: &[PackedTriangle] = &scene.triangles;
+    let triangles: &[Triangle] = &scene.triangles;
     let mut hit = best;
     let inv_dir = safe_inv_dir(ray.dir);
     let oct_inv4 = octant_inv4(ray.dir);

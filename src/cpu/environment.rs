@@ -30,7 +30,7 @@ pub fn environment_radiance(scene: &PackedScene, params: &Params, dir: Vec3) -> 
     if params.env_width == 0 {
         return params.environment.into();
     }
-    let t = scene.env[env_texel_index(params, env_uv(dir)) as usize];
+    let t = scene.light_data[env_texel_index(params, env_uv(dir)) as usize];
     Vec3::new(t[0], t[1], t[2]) * Vec3::from(params.environment)
 }
 
@@ -42,7 +42,7 @@ pub fn environment_pdf(scene: &PackedScene, params: &Params, dir: Vec3) -> f32 {
     let index = env_texel_index(params, env_uv(dir));
     let i = index / w;
     let sin_centre = (PI * (i as f32 + 0.5) / h as f32).sin();
-    let t = scene.env[index as usize];
+    let t = scene.light_data[index as usize];
     let func = luminance(Vec3::new(t[0], t[1], t[2])) * sin_centre;
     let sin_dir = Vec2::new(dir.x, dir.z).length();
     if sin_dir <= 0.0 || params.env_total <= 0.0 {
@@ -52,10 +52,10 @@ pub fn environment_pdf(scene: &PackedScene, params: &Params, dir: Vec3) -> f32 {
     params.env_select * pdf_uv / (2.0 * PI * PI * sin_dir)
 }
 
-/// Twin of `env_sample_cdf`: inverts the CDF in `scene.env[base .. base + n]` (component 0 for
+/// Twin of `env_sample_cdf`: inverts the CDF in `scene.light_data[base .. base + n]` (component 0 for
 /// the marginal, 3 for a row), returning the entry and `u`'s place inside it.
 pub fn env_sample_cdf(scene: &PackedScene, base: u32, n: u32, u: f32, marginal: bool) -> Vec2 {
-    let cdf = |k: u32| scene.env[(base + k) as usize][if marginal { 0 } else { 3 }];
+    let cdf = |k: u32| scene.light_data[(base + k) as usize][if marginal { 0 } else { 3 }];
     let (mut lo, mut hi) = (0u32, n - 1);
     while lo < hi {
         let mid = (lo + hi) / 2;

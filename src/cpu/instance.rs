@@ -1,12 +1,12 @@
 //! Twin of `shaders/instance.wgsl`: instance records and moving hit data to world space.
 
-use crate::packed::{INSTANCE_MIRRORED, PackedInstance, PackedScene, PackedTriangle, TRI_MIRRORED};
+use crate::packed::{INSTANCE_MIRRORED, Instance, PackedScene, TRI_MIRRORED, Triangle};
 use glam::{Vec3, Vec4};
 
 /// The record of instance `k` (the kernel finds it through params.instance_base, the same value).
-pub fn load_instance(scene: &PackedScene, k: u32) -> PackedInstance {
+pub fn load_instance(scene: &PackedScene, k: u32) -> Instance {
     let base = (scene.instance_base + 4 * k) as usize;
-    bytemuck::cast_slice::<_, PackedInstance>(&scene.nodes[base..base + 4])[0]
+    bytemuck::cast_slice::<_, Instance>(&scene.nodes[base..base + 4])[0]
 }
 
 pub fn transform_point(m: &[[f32; 4]; 3], p: Vec3) -> Vec3 {
@@ -24,7 +24,7 @@ pub fn transform_normal(world_to_object: &[[f32; 4]; 3], n: Vec3) -> Vec3 {
     n.x * r(0) + n.y * r(1) + n.z * r(2)
 }
 
-pub fn world_triangle(scene: &PackedScene, index: u32, instance: u32) -> PackedTriangle {
+pub fn world_triangle(scene: &PackedScene, index: u32, instance: u32) -> Triangle {
     let mut tri = scene.triangles[index as usize];
     if scene.instance_count == 0 {
         return tri;

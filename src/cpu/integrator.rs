@@ -11,7 +11,7 @@ use super::material::{material_at, shading_normal, triangle_uv};
 use super::mis::mis_weight;
 use super::sampler::{Sampler, sample_1d, sample_2d};
 use crate::Strategy;
-use crate::packed::{PackedMaterial, PackedScene, TRI_MIRRORED};
+use crate::packed::{Material, PackedScene, TRI_MIRRORED};
 use crate::params::Params;
 use glam::{UVec2, Vec3};
 
@@ -27,7 +27,7 @@ fn spawn_point(point: Vec3, ng: Vec3, wi: Vec3) -> Vec3 {
 #[allow(clippy::too_many_arguments)]
 fn connect(
     scene: &PackedScene,
-    m: &PackedMaterial,
+    m: &Material,
     frame: &Frame,
     wo: Vec3,
     eta: f32,
@@ -58,7 +58,7 @@ fn unoccluded(scene: &PackedScene, origin: Vec3, ls: &LightSample) -> bool {
 }
 
 pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut Sampler) -> Vec3 {
-    let strategy = Strategy::from_u32(params.strategy);
+    let strategy = Strategy::try_from(params.strategy).unwrap_or(Strategy::MisPower);
     let mut radiance = Vec3::ZERO;
     let mut beta = Vec3::ONE;
     let mut ray = camera_ray;

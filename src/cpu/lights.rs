@@ -4,7 +4,7 @@ use super::bvh::INF;
 use super::environment::{environment_pdf, environment_radiance, sample_environment};
 use super::material::{material_at, triangle_uv};
 use super::sampling::sample_uniform_triangle;
-use crate::packed::{NO_TEXTURE, PUNCTUAL_POINT, PUNCTUAL_SPOT, PackedPunctual, PackedScene, PackedTriangle};
+use crate::packed::{NO_TEXTURE, PUNCTUAL_POINT, PUNCTUAL_SPOT, PackedScene, Punctual, Triangle};
 use crate::params::Params;
 use glam::{Vec2, Vec3};
 
@@ -60,13 +60,13 @@ pub fn sample_light(scene: &PackedScene, params: &Params, ref_point: Vec3, u: Ve
     LightSample { wi, dist, point, normal, radiance, pdf: light_pdf(params, tri, dist2, cos_light) }
 }
 
-pub fn light_pdf(params: &Params, tri: &PackedTriangle, dist2: f32, cos_light: f32) -> f32 {
+pub fn light_pdf(params: &Params, tri: &Triangle, dist2: f32, cos_light: f32) -> f32 {
     (1.0 - params.env_select) * tri.light_pdf_area * dist2 / cos_light.abs()
 }
 
-pub fn punctual_light(scene: &PackedScene, params: &Params, index: u32) -> PackedPunctual {
+pub fn punctual_light(scene: &PackedScene, params: &Params, index: u32) -> Punctual {
     let base = (params.punctual_base + 4 * index) as usize;
-    bytemuck::cast_slice::<[f32; 4], PackedPunctual>(&scene.env[base..base + 4])[0]
+    bytemuck::cast_slice::<[f32; 4], Punctual>(&scene.light_data[base..base + 4])[0]
 }
 
 pub fn sample_punctual(scene: &PackedScene, params: &Params, ref_point: Vec3, u: f32) -> LightSample {

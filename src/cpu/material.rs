@@ -5,8 +5,8 @@ use super::instance::{load_instance, transform_dir, transform_normal};
 use super::rng::pcg_hash;
 use super::texture::sample_texture;
 use crate::packed::{
-    MAT_ALPHA_MASK, NO_TEXTURE, PackedMaterial, PackedScene, PackedTriangle, TRI_HAS_NORMALS, TRI_HAS_TANGENTS,
-    TRI_MIRRORED, TRI_TANGENT_SIGN_SHIFT, oct_decode,
+    MAT_ALPHA_MASK, Material, NO_TEXTURE, PackedScene, TRI_HAS_NORMALS, TRI_HAS_TANGENTS, TRI_MIRRORED,
+    TRI_TANGENT_SIGN_SHIFT, Triangle, oct_decode,
 };
 use glam::{Vec2, Vec3};
 
@@ -15,7 +15,7 @@ pub fn triangle_uv(scene: &PackedScene, index: u32, u: f32, v: f32) -> Vec2 {
     (1.0 - u - v) * Vec2::from(a.uv[0]) + u * Vec2::from(a.uv[1]) + v * Vec2::from(a.uv[2])
 }
 
-pub fn material_at(scene: &PackedScene, m: &PackedMaterial, uv: Vec2) -> PackedMaterial {
+pub fn material_at(scene: &PackedScene, m: &Material, uv: Vec2) -> Material {
     let mut r = *m;
     if m.base_color_texture.layer != NO_TEXTURE {
         let c = sample_texture(scene, &m.base_color_texture, uv);
@@ -59,13 +59,13 @@ pub fn nearest_vertex(u: f32, v: f32) -> u32 {
 #[allow(clippy::too_many_arguments)]
 pub fn shading_normal(
     scene: &PackedScene,
-    tri: &PackedTriangle,
+    tri: &Triangle,
     index: u32,
     instance: u32,
     u: f32,
     v: f32,
     ng: Vec3,
-    m: &PackedMaterial,
+    m: &Material,
     uv: Vec2,
 ) -> Vec3 {
     let mut n = ng;

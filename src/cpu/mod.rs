@@ -14,9 +14,11 @@ pub mod lights;
 pub mod material;
 pub mod microfacet;
 pub mod mis;
+pub mod renderer;
 pub mod rng;
 pub mod sampler;
 pub mod sampling;
 pub mod texture;
 
 pub use integrator::render_sample;
+pub use renderer::Renderer;

@@ -4,8 +4,8 @@
 use super::rng::{pcg_hash, rng_init, rng_next};
 use glam::Vec2;
 
-pub const SAMPLER_INDEPENDENT: u32 = 0;
-pub const SAMPLER_SOBOL: u32 = 1;
+pub const SAMPLER_INDEPENDENT: u32 = crate::SamplerKind::Independent as u32;
+pub const SAMPLER_SOBOL: u32 = crate::SamplerKind::Sobol as u32;
 
 pub struct Sampler {
     kind: u32,

@@ -1,6 +1,6 @@
 //! Twin of `shaders/texture.wgsl`: bilinear texture reads with glTF wrap modes.
 
-use crate::packed::{PackedScene, PackedTextureRef, TEX_SRGB};
+use crate::packed::{PackedScene, TEX_SRGB, TextureRef};
 use glam::{Vec2, Vec3, Vec4};
 
 pub fn wrap_texel(i: i32, n: i32, mode: u32) -> i32 {
@@ -18,7 +18,7 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }
 
-fn texel(scene: &PackedScene, t: &PackedTextureRef, x: i32, y: i32, n: i32) -> Vec4 {
+fn texel(scene: &PackedScene, t: &TextureRef, x: i32, y: i32, n: i32) -> Vec4 {
     let (x, y) = (wrap_texel(x, n, t.mode & 3), wrap_texel(y, n, (t.mode >> 2) & 3));
     let index = (t.layer as usize * n as usize + y as usize) * n as usize + x as usize;
     let c = scene.texels[index].to_le_bytes().map(|b| b as f32 / 255.0);
@@ -29,7 +29,7 @@ fn texel(scene: &PackedScene, t: &PackedTextureRef, x: i32, y: i32, n: i32) -> V
     }
 }
 
-pub fn sample_texture(scene: &PackedScene, t: &PackedTextureRef, uv: Vec2) -> Vec4 {
+pub fn sample_texture(scene: &PackedScene, t: &TextureRef, uv: Vec2) -> Vec4 {
     let n = scene.texture_size as i32;
     let uv1 = uv.extend(1.0);
     let st = Vec2::new(Vec3::from(t.row0).dot(uv1), Vec3::from(t.row1).dot(uv1));

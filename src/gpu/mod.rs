@@ -10,20 +10,23 @@ use crate::params::Params;
 use std::sync::{Arc, Mutex};
 use wgpu::util::DeviceExt;
 
-pub const NO_ADAPTER_HINT: &str = "no Vulkan adapter found; for the GPU path install a Vulkan driver (Debian/Ubuntu: apt-get install mesa-vulkan-drivers)";
+pub const NO_ADAPTER_HINT: &str = "no GPU adapter found (Vulkan, Metal or DX12); for the GPU path install a Vulkan driver (Debian/Ubuntu: apt-get install mesa-vulkan-drivers)";
+
+/// The native backends that run compute shaders; WGPU_BACKEND narrows them.
+const BACKENDS: wgpu::Backends = wgpu::Backends::VULKAN.union(wgpu::Backends::METAL).union(wgpu::Backends::DX12);
 
 fn instance() -> wgpu::Instance {
     wgpu::Instance::new(wgpu::InstanceDescriptor {
-        backends: wgpu::Backends::VULKAN.with_env(),
+        backends: BACKENDS.with_env(),
         flags: wgpu::InstanceFlags::empty().with_env(),
         ..wgpu::InstanceDescriptor::new_without_display_handle()
     })
 }
 
-/// Every Vulkan adapter found, with its limits.
+/// Every adapter found on the compute backends, with its limits.
 pub fn adapters() -> Vec<(wgpu::AdapterInfo, wgpu::Limits)> {
     let inst = instance();
-    pollster::block_on(inst.enumerate_adapters(wgpu::Backends::VULKAN.with_env()))
+    pollster::block_on(inst.enumerate_adapters(BACKENDS.with_env()))
         .iter()
         .map(|a| (a.get_info(), a.limits()))
         .collect()
@@ -51,15 +54,20 @@ impl GpuContext {
         GpuContext { device, queue, info, errors }
     }
 
+    /// The adapter's driver, as `veach info` prints it.
+    pub fn driver(&self) -> String {
+        format!("{} {}", self.info.driver, self.info.driver_info)
+    }
+
     pub fn new() -> Result<GpuContext, Error> {
         let inst = instance();
         // WGPU_ADAPTER_NAME picks an adapter by name; an unmatched name is our error, not a panic.
         let wanted = std::env::var("WGPU_ADAPTER_NAME").ok().map(|s| s.to_lowercase());
         let adapter = match wanted {
-            Some(name) => pollster::block_on(inst.enumerate_adapters(wgpu::Backends::VULKAN.with_env()))
+            Some(name) => pollster::block_on(inst.enumerate_adapters(BACKENDS.with_env()))
                 .into_iter()
                 .find(|a| a.get_info().name.to_lowercase().contains(&name))
-                .ok_or_else(|| Error::NoAdapter(format!("no Vulkan adapter matches WGPU_ADAPTER_NAME={name}")))?,
+                .ok_or_else(|| Error::NoAdapter(format!("no GPU adapter matches WGPU_ADAPTER_NAME={name}")))?,
             None => pollster::block_on(inst.request_adapter(&wgpu::RequestAdapterOptions {
                 power_preference: wgpu::PowerPreference::HighPerformance,
                 ..Default::default()
@@ -74,20 +82,14 @@ impl GpuContext {
             ..Default::default()
         }))
         .map_err(|e| Error::Gpu(format!("cannot open {}: {e}", info.name)))?;
-        let errors = Arc::new(Mutex::new(None));
-        let sink = errors.clone();
-        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-            if let Ok(mut slot) = sink.lock() {
-                slot.get_or_insert_with(|| e.to_string());
-            }
-        }));
-        let lost = errors.clone();
-        device.set_device_lost_callback(move |_reason, msg| {
+        let ctx = GpuContext::from_device(device, queue, info);
+        let lost = ctx.errors.clone();
+        ctx.device.set_device_lost_callback(move |_reason, msg| {
             if let Ok(mut slot) = lost.lock() {
                 slot.get_or_insert_with(|| format!("device lost: {msg}"));
             }
         });
-        Ok(GpuContext { device, queue, info, errors })
+        Ok(ctx)
     }
 
     pub fn check(&self) -> Result<(), Error> {
@@ -133,24 +135,7 @@ impl GpuRenderer {
     pub fn new(ctx: GpuContext, scene: &PackedScene, params: Params) -> Result<GpuRenderer, Error> {
         let device = &ctx.device;
         let limits = device.limits();
-        let storage = |label: &str, bytes: &[u8]| -> Result<wgpu::Buffer, Error> {
-            let len = bytes.len() as u64;
-            check_limit(label, len, limits.max_storage_buffer_binding_size, "max_storage_buffer_binding_size")?;
-            check_limit(label, len, limits.max_buffer_size, "max_buffer_size")?;
-            // Zero-sized bindings are invalid; an empty array gets one zeroed element.
-            let padded;
-            let contents = if bytes.is_empty() {
-                padded = vec![0u8; 16];
-                &padded[..]
-            } else {
-                bytes
-            };
-            Ok(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE,
-            }))
-        };
+        let storage = |label: &str, bytes: &[u8]| storage_buffer(device, label, bytes);
         let geometry_bytes: [&[u8]; 3] = [
             bytemuck::cast_slice(&scene.nodes),
             bytemuck::cast_slice(&scene.triangles),
@@ -167,7 +152,7 @@ impl GpuRenderer {
             storage("vertex attributes", geometry_buffers[2])?,
             storage("materials", bytemuck::cast_slice(&scene.materials))?,
             storage("lights", bytemuck::cast_slice(&scene.lights))?,
-            storage("light data", bytemuck::cast_slice(&scene.env))?,
+            storage("light data", bytemuck::cast_slice(&scene.light_data))?,
         ];
         let (textures, texture_bytes) = Self::texture_array(&ctx, scene)?;
         // One Params slot per dispatch of a batch, each at an aligned offset.
@@ -395,6 +380,24 @@ impl GpuRenderer {
         Ok((film_buf, readback, bind_group))
     }
 
+    /// A new environment: the light-data buffer is replaced (geometry stays on the device)
+    /// and accumulation restarts with `params`.
+    pub fn set_environment(&mut self, scene: &PackedScene, params: Params) -> Result<(), Error> {
+        self.scene[5] = storage_buffer(&self.ctx.device, "light data", bytemuck::cast_slice(&scene.light_data))?;
+        let (film, readback, bind_group) = Self::film(
+            &self.ctx,
+            &self.layout,
+            &self.scene,
+            self.geometry.as_ref(),
+            &self.textures,
+            &self.params_buf,
+            params,
+        )?;
+        (self.film_buf, self.readback, self.bind_group) = (film, readback, bind_group);
+        self.params = params;
+        self.ctx.check()
+    }
+
     /// New parameters (camera, settings, window) and an empty film: the viewer's restart.
     pub fn reset(&mut self, params: Params) -> Result<(), Error> {
         if (params.film_width, params.film_height) != (self.params.film_width, self.params.film_height) {
@@ -588,9 +591,32 @@ fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
 
 fn check_limit(what: &str, bytes: u64, limit: u64, name: &str) -> Result<(), Error> {
     if bytes > limit {
+        // Only the film shrinks with a tile; the scene's buffers do not.
+        let advice = if what == "film" { "; render tiles (--tile)" } else { "" };
         return Err(Error::Limit(format!(
-            "the {what} buffer needs {bytes} bytes, above the device limit {name} = {limit}; render tiles (--tile)"
+            "the {what} buffer needs {bytes} bytes, above the device limit {name} = {limit}{advice}"
         )));
     }
     Ok(())
+}
+
+/// A read-only storage buffer holding `bytes`, within the device's binding limits.
+fn storage_buffer(device: &wgpu::Device, label: &str, bytes: &[u8]) -> Result<wgpu::Buffer, Error> {
+    let limits = device.limits();
+    let len = bytes.len() as u64;
+    check_limit(label, len, limits.max_storage_buffer_binding_size, "max_storage_buffer_binding_size")?;
+    check_limit(label, len, limits.max_buffer_size, "max_buffer_size")?;
+    // Zero-sized bindings are invalid; an empty array gets one zeroed element.
+    let padded;
+    let contents = if bytes.is_empty() {
+        padded = vec![0u8; 16];
+        &padded[..]
+    } else {
+        bytes
+    };
+    Ok(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE,
+    }))
 }

@@ -10,6 +10,30 @@ use std::path::Path;
 /// Largest accepted map: its texels must fit one 128 MiB storage binding as vec4<f32>.
 pub const MAX_TEXELS: usize = 8 << 20;
 
+/// What rays that leave the scene see: a constant radiance, or a map scaled by it. A
+/// swappable input of a render (`Renderer::set_environment`): changing it rebuilds no BVH.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Environment {
+    pub map: Option<std::sync::Arc<EnvironmentMap>>,
+    /// The constant radiance, or the tint of the map.
+    pub radiance: Vec3,
+}
+
+impl Environment {
+    pub fn constant(radiance: Vec3) -> Environment {
+        Environment { map: None, radiance }
+    }
+
+    pub fn map(map: EnvironmentMap, tint: Vec3) -> Environment {
+        Environment { map: Some(std::sync::Arc::new(map)), radiance: tint }
+    }
+
+    /// Whether it lights the scene at all.
+    pub fn is_black(&self) -> bool {
+        self.radiance.max_element() <= 0.0
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct EnvironmentMap {
     pub width: u32,

@@ -235,7 +235,7 @@ fn from_document(
         return Err("the file has no scene".into());
     };
     if let Some(env) = environment_from_extras(gltf_scene.extras()) {
-        scene.environment = env;
+        scene.environment.radiance = env;
     }
 
     // Meshes drawn by several nodes are stored once and instanced, unless they emit (lights

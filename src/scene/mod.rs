@@ -9,7 +9,7 @@ pub mod gltf;
 pub mod tangents;
 
 pub use camera::Camera;
-pub use environment::EnvironmentMap;
+pub use environment::{Environment, EnvironmentMap};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 /// One world-space triangle. Counter-clockwise winding is the front face.
@@ -213,10 +213,8 @@ pub struct Scene {
     pub instances: Vec<Instance>,
     pub materials: Vec<Material>,
     pub cameras: Vec<Camera>,
-    /// Environment radiance seen by rays that leave the scene: a constant color, or the
-    /// scale of `environment_map` when there is one.
-    pub environment: Vec3,
-    pub environment_map: Option<EnvironmentMap>,
+    /// What rays that leave the scene see.
+    pub environment: Environment,
     pub textures: Vec<Texture>,
     pub punctual_lights: Vec<PunctualLight>,
     /// Things the loader ignored, one line each (unknown optional extensions, ...).

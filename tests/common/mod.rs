@@ -53,12 +53,30 @@ pub fn render(scene: &Path, settings: &Settings, spp: u32, ctx: Option<GpuContex
 }
 
 pub fn try_render(scene: &Path, settings: &Settings, spp: u32, ctx: Option<GpuContext>) -> Result<Film, Error> {
-    let (s, camera) = veach::load(scene, settings.camera.as_deref())?;
+    let (s, camera) = load_pair(scene, settings.camera.as_deref())?;
     let packed = veach::packed::PackedScene::new(&s);
-    let backend = if ctx.is_some() { Backend::Gpu } else { Backend::Cpu };
-    let mut r = Renderer::with_gpu(packed, &camera, settings, backend, ctx)?;
+    let mut r = renderer(packed, &camera, settings, ctx)?;
     r.render_samples(0, spp)?;
     r.film()
+}
+
+/// Loads a scene file and its first (or named) camera.
+pub fn load_pair(path: &Path, camera: Option<&str>) -> Result<(veach::Scene, veach::Camera), Error> {
+    let loaded = veach::load(path, camera)?;
+    Ok((loaded.scene, loaded.camera))
+}
+
+/// A renderer on the GPU when given a context, else on the CPU reference.
+pub fn renderer(
+    scene: veach::PackedScene,
+    camera: &veach::Camera,
+    settings: &Settings,
+    ctx: Option<GpuContext>,
+) -> Result<Renderer, Error> {
+    match ctx {
+        Some(ctx) => Renderer::with_context(scene, camera, settings, ctx),
+        None => Renderer::new(scene, camera, settings, Backend::Cpu),
+    }
 }
 
 /// A reference image and its per-pixel standard error from tests/data.

@@ -1,0 +1,333 @@
+//! The command line's schema: subcommands and their flags, and the flag parsers.
+
+use clap::{Parser, Subcommand};
+use glam::Vec3;
+use std::path::PathBuf;
+use veach::tonemap::Tonemap;
+use veach::{Backend, SamplerKind, Strategy, Tile};
+
+#[derive(Parser)]
+#[command(
+    name = "veach",
+    version,
+    about = "A physically based GPU path tracer built around multiple importance sampling"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Render a glTF 2.0 scene (.gltf/.glb) to a PNG (tone-mapped) or EXR (linear).
+    Render(RenderArgs),
+    /// Open the interactive preview window (egui), refining progressively on the GPU.
+    View(ViewArgs),
+    /// Merge renders of disjoint sample ranges or tiles (EXRs written by veach) into one image.
+    Merge(MergeArgs),
+    /// Render the seed's four direct-lighting estimators at equal spp, side by side with labels.
+    Strategies(StrategiesArgs),
+    /// Plot RMSE against render time (log-log) for renders made with --reference and
+    /// --stats-json: compare samplers, estimators and backends at equal time.
+    PlotConvergence(PlotArgs),
+    /// Benchmark: the Cornell box, the Veach scene and a generated ~260k-triangle scene on
+    /// each backend (samples/s), with load and BVH-build times, geometry bytes per triangle
+    /// and BVH traversal throughput. See BENCHMARKS.md and bench/compare-mitsuba.sh.
+    Bench(BenchArgs),
+    /// List the Vulkan adapters and their limits, or describe a scene.
+    Info {
+        /// A .gltf/.glb file: print its triangles, meshes, instances, materials, textures,
+        /// lights, extensions and bounds.
+        scene: Option<PathBuf>,
+    },
+}
+
+#[derive(clap::Args)]
+pub struct ViewArgs {
+    /// The scene, a .gltf or .glb file (or open one from the window).
+    pub scene: Option<PathBuf>,
+    /// Render --frames frames, save a screenshot of the whole window here (.png), and exit.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    #[arg(long, default_value_t = 30)]
+    pub frames: u32,
+    #[arg(long, default_value_t = 8)]
+    pub max_depth: u32,
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    #[arg(long, value_parser = parse_rgb)]
+    pub env_color: Option<Vec3>,
+    /// Window size WxH in points.
+    #[arg(long, value_parser = parse_size, default_value = "1100x720")]
+    pub window: (u32, u32),
+    /// Fraction of the image area's resolution rendered when the camera is still.
+    #[arg(long, default_value_t = 1.0)]
+    pub render_scale: f32,
+}
+
+/// The smallest window side the viewer lays out its panel in.
+const MIN_WINDOW_SIDE: u32 = 64;
+
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once('x').ok_or("expected WxH, e.g. 1100x720")?;
+    let w: u32 = w.parse().map_err(|e| format!("'{w}': {e}"))?;
+    let h: u32 = h.parse().map_err(|e| format!("'{h}': {e}"))?;
+    let sides = MIN_WINDOW_SIDE..=veach::MAX_IMAGE_SIDE;
+    if !sides.contains(&w) || !sides.contains(&h) {
+        return Err(format!("window sides must be {MIN_WINDOW_SIDE}..={}", veach::MAX_IMAGE_SIDE));
+    }
+    Ok((w, h))
+}
+
+#[derive(clap::Args)]
+pub struct MergeArgs {
+    /// The parts: EXR files written by `veach render` (with --sample-range or --tile).
+    #[arg(required = true)]
+    pub parts: Vec<PathBuf>,
+    /// The merged image (.exr keeps the film, .png is tone-mapped).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_finite)]
+    pub exposure: f32,
+}
+
+#[derive(clap::Args)]
+pub struct PlotArgs {
+    /// Statistics files written by `veach render --reference REF.exr --stats-json FILE`.
+    #[arg(required = true)]
+    pub stats: Vec<PathBuf>,
+    /// The plot (.png).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Horizontal axis: render seconds (equal-time comparison) or samples per pixel.
+    #[arg(long, value_enum, default_value_t = PlotX::Seconds)]
+    pub x: PlotX,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum PlotX {
+    Seconds,
+    Spp,
+}
+
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    #[arg(long, default_value_t = 256)]
+    pub width: u32,
+    #[arg(long, default_value_t = 256)]
+    pub height: u32,
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Path segments, as Mitsuba's max_depth (8: up to 7 bounces).
+    #[arg(long, default_value_t = 8)]
+    pub max_depth: u32,
+    /// Backends to run (repeat the flag for several); default: gpu and cpu.
+    #[arg(long, value_enum)]
+    pub backend: Vec<Backend>,
+    /// Spheres per side in the generated large scene (~16k triangles each; 4 = ~262k).
+    #[arg(long, default_value_t = 4)]
+    pub large_grid: u32,
+    /// Also write the results as JSON to this file.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+pub struct StrategiesArgs {
+    /// The scene, a .gltf or .glb file.
+    pub scene: PathBuf,
+    /// Output contact sheet (.png).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Samples per pixel of each estimator.
+    #[arg(long, default_value_t = 16)]
+    pub spp: u32,
+    /// Width of each panel.
+    #[arg(long, default_value_t = 256)]
+    pub width: u32,
+    /// Height of each panel.
+    #[arg(long, default_value_t = 256)]
+    pub height: u32,
+    /// Path depth in segments (2 = direct lighting only, the seed's setting).
+    #[arg(long, default_value_t = 2)]
+    pub max_depth: u32,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_finite)]
+    pub exposure: f32,
+    #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
+    pub tonemap: Tonemap,
+    #[arg(long, value_enum)]
+    pub backend: Option<Backend>,
+    #[command(flatten)]
+    pub look: LookArgs,
+}
+
+/// What the camera sees: which camera, and the environment.
+#[derive(clap::Args)]
+pub struct LookArgs {
+    /// Camera node name (default: the first camera, else a view framing the scene).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Constant environment radiance R,G,B (default: the scene's extras.environment, else black).
+    #[arg(long, value_parser = parse_rgb)]
+    pub env_color: Option<Vec3>,
+    /// Equirectangular environment map (.hdr or .exr), importance-sampled; --env-color tints it.
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    /// Scales the environment (map or color).
+    #[arg(long, default_value_t = 1.0, value_parser = parse_non_negative)]
+    pub env_strength: f32,
+    /// Thin-lens radius in scene units for depth of field (default: a pinhole).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_non_negative)]
+    pub aperture: f32,
+    /// Distance in focus (default with --aperture: what the image centre sees).
+    #[arg(long, value_parser = parse_positive)]
+    pub focus_distance: Option<f32>,
+}
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// The scene, a .gltf or .glb file (not needed with --resume).
+    #[arg(required_unless_present = "resume")]
+    pub scene: Option<PathBuf>,
+    /// Output image; the extension picks the format: .png (exposure, clamp, sRGB) or .exr
+    /// (linear f32 RGB, plus the film and the job so that it can be resumed or merged).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Samples per pixel.
+    #[arg(long, conflicts_with = "resume", default_value_t = 64)]
+    pub spp: u32,
+    #[arg(long, conflicts_with = "resume", default_value_t = 512)]
+    pub width: u32,
+    #[arg(long, conflicts_with = "resume", default_value_t = 512)]
+    pub height: u32,
+    /// Longest path, counted in segments as Mitsuba's max_depth: 1 = emitters seen directly,
+    /// 2 = direct lighting only, 8 = up to 7 bounces (pbrt's maxdepth is this minus 1);
+    /// 0 = no limit (Russian roulette, from 3 segments on, ends paths).
+    #[arg(long, conflicts_with = "resume", default_value_t = 8)]
+    pub max_depth: u32,
+    /// Seed of the random sequences; the same seed renders the same image.
+    #[arg(long, conflicts_with = "resume", default_value_t = 0)]
+    pub seed: u32,
+    /// Exposure in stops applied before the PNG is tone-mapped (EXR stays linear).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_finite)]
+    pub exposure: f32,
+    /// Tone mapper of PNG output.
+    #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
+    pub tonemap: Tonemap,
+    /// Direct-lighting estimator.
+    #[arg(long, value_enum, conflicts_with = "resume", default_value_t = Strategy::MisPower)]
+    pub strategy: Strategy,
+    /// Sample generator: sobol (Owen-scrambled, lower error at equal spp) or independent.
+    #[arg(long, value_enum, conflicts_with = "resume", default_value_t = SamplerKind::Sobol)]
+    pub sampler: SamplerKind,
+    /// gpu (Vulkan; falls back to cpu with a warning when no adapter exists unless given explicitly) or cpu.
+    #[arg(long, value_enum)]
+    pub backend: Option<Backend>,
+    #[command(flatten)]
+    pub look: LookArgs,
+    /// Render only sample indices START..END (a render-farm split; overrides --spp). Random
+    /// numbers are keyed by sample index, so parts merge (`veach merge`) into the full render.
+    #[arg(long, conflicts_with = "resume", value_parser = parse_range)]
+    pub sample_range: Option<(u32, u32)>,
+    /// Render only the window X,Y,W,H of the image (an image-space split, merged by `veach merge`).
+    #[arg(long, conflicts_with = "resume", value_parser = parse_tile)]
+    pub tile: Option<Tile>,
+    /// Save the film and the job to this EXR periodically and at exit, for --resume.
+    #[arg(long)]
+    pub checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints.
+    #[arg(long, default_value_t = 60.0, value_parser = parse_seconds)]
+    pub checkpoint_every: f64,
+    /// Continue the render saved in this checkpoint (or any EXR veach wrote) to its target.
+    #[arg(long)]
+    pub resume: Option<PathBuf>,
+    /// Write render statistics as JSON.
+    #[arg(long)]
+    pub stats_json: Option<PathBuf>,
+    /// A converged image of the same size (EXR): record the RMSE against it at 1, 2, 4, ...
+    /// spp and the end, with the render time, in --stats-json ("convergence").
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+}
+
+pub fn parse_range(s: &str) -> Result<(u32, u32), String> {
+    let (a, b) = s.split_once("..").ok_or("expected START..END, e.g. 0..32")?;
+    let a: u32 = a.trim().parse().map_err(|e| format!("'{a}': {e}"))?;
+    let b: u32 = b.trim().parse().map_err(|e| format!("'{b}': {e}"))?;
+    if b <= a {
+        return Err(format!("{a}..{b} is empty"));
+    }
+    Ok((a, b))
+}
+
+pub fn parse_tile(s: &str) -> Result<Tile, String> {
+    let v: Vec<u32> =
+        s.split(',').map(|x| x.trim().parse::<u32>().map_err(|e| format!("'{x}': {e}"))).collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y, width, height] if width > 0 && height > 0 => Ok(Tile { x, y, width, height }),
+        _ => Err("expected X,Y,W,H with W, H > 0".into()),
+    }
+}
+
+pub fn parse_rgb(s: &str) -> Result<Vec3, String> {
+    let v: Vec<f32> =
+        s.split(',').map(|x| x.trim().parse::<f32>().map_err(|e| format!("'{x}': {e}"))).collect::<Result<_, _>>()?;
+    match v[..] {
+        [r, g, b] if v.iter().all(|c| c.is_finite() && *c >= 0.0) => Ok(Vec3::new(r, g, b)),
+        [c] if c.is_finite() && c >= 0.0 => Ok(Vec3::splat(c)),
+        _ => Err("expected R,G,B with finite non-negative values".into()),
+    }
+}
+
+fn parse_f32(s: &str) -> Result<f32, String> {
+    s.trim().parse::<f32>().map_err(|e| format!("'{s}': {e}"))
+}
+
+/// A finite number (exposure).
+pub fn parse_finite(s: &str) -> Result<f32, String> {
+    let v = parse_f32(s)?;
+    if v.is_finite() { Ok(v) } else { Err(format!("{v}: expected a finite number")) }
+}
+
+/// A finite number ≥ 0 (aperture, environment strength).
+pub fn parse_non_negative(s: &str) -> Result<f32, String> {
+    let v = parse_f32(s)?;
+    if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(format!("{v}: expected a finite number ≥ 0")) }
+}
+
+/// A finite number > 0 (focus distance).
+pub fn parse_positive(s: &str) -> Result<f32, String> {
+    let v = parse_f32(s)?;
+    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(format!("{v}: expected a finite number > 0")) }
+}
+
+/// Seconds: finite and > 0.
+pub fn parse_seconds(s: &str) -> Result<f64, String> {
+    let v: f64 = s.trim().parse().map_err(|e| format!("'{s}': {e}"))?;
+    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(format!("{v}: expected a finite number of seconds > 0")) }
+}
+
+impl LookArgs {
+    /// These flags as render settings.
+    pub fn apply(&self, settings: &mut veach::Settings) {
+        let absolute = |p: &std::path::Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+        settings.camera = self.camera.clone();
+        settings.env_map = self.env.as_deref().map(absolute);
+        settings.env_color = self.env_color.map(Into::into);
+        settings.env_strength = self.env_strength;
+        settings.aperture = self.aperture;
+        settings.focus_distance = self.focus_distance;
+    }
+
+    /// Whether any of these flags was given (they conflict with --resume).
+    pub fn any(&self) -> bool {
+        self.camera.is_some()
+            || self.env_color.is_some()
+            || self.env.is_some()
+            || self.env_strength != 1.0
+            || self.aperture != 0.0
+            || self.focus_distance.is_some()
+    }
+}

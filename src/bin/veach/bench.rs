@@ -1,0 +1,24 @@
+//! `veach bench`: samples/s and traversal throughput per backend (see BENCHMARKS.md).
+
+use crate::args::BenchArgs;
+use veach::{Backend, Error};
+
+pub fn run(args: &BenchArgs) -> Result<(), Error> {
+    if args.width == 0 || args.height == 0 || args.spp == 0 || args.large_grid == 0 || args.large_grid > 32 {
+        return Err(Error::Input("bench: sizes and spp must be positive, --large-grid in 1..=32".into()));
+    }
+    let backends = if args.backend.is_empty() { vec![Backend::Gpu, Backend::Cpu] } else { args.backend.clone() };
+    let opts = veach::bench::BenchOptions {
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        max_depth: args.max_depth,
+        large_grid: args.large_grid,
+    };
+    let report = veach::bench::run(&opts, &backends, &mut |line| eprintln!("veach bench: {line}"))?;
+    print!("{}", veach::bench::format_report(&report));
+    if let Some(path) = &args.json {
+        veach::output::write_atomic(path, serde_json::to_string_pretty(&report).unwrap_or_default().as_bytes())?;
+    }
+    Ok(())
+}

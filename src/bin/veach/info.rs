@@ -1,0 +1,30 @@
+//! `veach info`: the GPU adapters and their limits, or a scene's contents.
+
+use std::path::Path;
+use veach::Error;
+
+pub fn run(scene: Option<&Path>) -> Result<(), Error> {
+    if let Some(path) = scene {
+        println!("{}", veach::scene::gltf::describe_file(path)?);
+        return Ok(());
+    }
+    let adapters = veach::gpu::adapters();
+    if adapters.is_empty() {
+        return Err(Error::NoAdapter(veach::gpu::NO_ADAPTER_HINT.into()));
+    }
+    for (info, limits) in adapters {
+        println!(
+            "{} ({:?}, {:?}, driver {} {})",
+            info.name, info.device_type, info.backend, info.driver, info.driver_info
+        );
+        println!("  max_storage_buffer_binding_size {}", limits.max_storage_buffer_binding_size);
+        println!("  max_buffer_size {}", limits.max_buffer_size);
+        println!("  max_texture_dimension_2d {}", limits.max_texture_dimension_2d);
+        println!("  max_texture_array_layers {}", limits.max_texture_array_layers);
+        println!("  max_compute_workgroups_per_dimension {}", limits.max_compute_workgroups_per_dimension);
+        println!("  max_compute_invocations_per_workgroup {}", limits.max_compute_invocations_per_workgroup);
+        println!("  max_storage_buffers_per_shader_stage {}", limits.max_storage_buffers_per_shader_stage);
+        println!("  subgroup size {}..{}", info.subgroup_min_size, info.subgroup_max_size);
+    }
+    Ok(())
+}

@@ -1,0 +1,102 @@
+//! The `veach` command line: a thin shell over the library, one file per subcommand.
+
+mod args;
+mod bench;
+mod info;
+mod label;
+mod merge;
+mod plot;
+mod plot_image;
+mod render;
+mod strategies;
+mod view;
+
+use clap::Parser;
+use std::process::ExitCode;
+use veach::Error;
+
+/// How a command ended, when it did not fail.
+pub enum Outcome {
+    Done,
+    /// Stopped by a signal, with its work kept.
+    Interrupted,
+}
+
+/// Exit status of an interrupted render that kept its work.
+const EXIT_INTERRUPTED: u8 = 130;
+
+fn main() -> ExitCode {
+    quiet_vulkan_loader();
+    // A bug must still be one line on stderr, never a backtrace in a user's face.
+    std::panic::set_hook(Box::new(|info| {
+        let msg = info.payload().downcast_ref::<&str>().map(|s| s.to_string());
+        let msg = msg.or_else(|| info.payload().downcast_ref::<String>().cloned()).unwrap_or_default();
+        let at = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
+        eprintln!("veach: internal error{at}: {msg} (please report it)");
+    }));
+    let cli = args::Cli::parse();
+    let done = |r: Result<(), Error>| r.map(|_| Outcome::Done);
+    let result = match cli.command {
+        args::Command::Render(a) => render::run(&a),
+        args::Command::Merge(a) => done(merge::run(&a)),
+        args::Command::View(a) => done(view::run(a)),
+        args::Command::Strategies(a) => done(strategies::run(&a)),
+        args::Command::Bench(a) => done(bench::run(&a)),
+        args::Command::PlotConvergence(a) => done(plot::run(&a)),
+        args::Command::Info { scene } => done(info::run(scene.as_deref())),
+    };
+    match result {
+        Ok(Outcome::Done) => ExitCode::SUCCESS,
+        Ok(Outcome::Interrupted) => ExitCode::from(EXIT_INTERRUPTED),
+        Err(e) => {
+            eprintln!("veach: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Mesa's window-system code complains on every device creation when XDG_RUNTIME_DIR is
+/// unset (headless machines, CI); give it a private directory before any thread starts.
+fn quiet_vulkan_loader() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        let dir = std::env::temp_dir().join("veach-xdg-runtime");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::DirBuilderExt;
+            let _ = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        }
+        if dir.is_dir() {
+            // SAFETY: called first thing in main, before any other thread exists.
+            unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+        }
+    }
+}
+
+/// Prints the loader's warnings, one line each, naming the file.
+pub fn warn_all(what: &std::path::Path, warnings: &[String]) {
+    for w in warnings {
+        eprintln!("veach: warning: {}: {w}", what.display());
+    }
+}
+
+/// A renderer on the requested backend; with none requested, the GPU, or the CPU with a
+/// one-line warning when there is no GPU adapter.
+pub fn open_renderer(
+    packed: veach::PackedScene,
+    camera: &veach::Camera,
+    settings: &veach::Settings,
+    backend: Option<veach::Backend>,
+) -> Result<veach::Renderer, Error> {
+    use veach::{Backend, Renderer};
+    match backend {
+        Some(b) => Renderer::new(packed, camera, settings, b),
+        None => match veach::gpu::GpuContext::new() {
+            Ok(ctx) => Renderer::with_context(packed, camera, settings, ctx),
+            Err(Error::NoAdapter(msg)) => {
+                eprintln!("veach: warning: {msg}; rendering on the CPU backend");
+                Renderer::new(packed, camera, settings, Backend::Cpu)
+            }
+            Err(e) => Err(e),
+        },
+    }
+}

@@ -1,0 +1,193 @@
+//! `veach render`: a scene (or a resumed checkpoint) to PNG/EXR, with checkpoints,
+//! statistics and convergence measurements, over `veach::render_progressive`.
+
+use crate::Outcome;
+use crate::args::RenderArgs;
+use glam::Vec3;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+use veach::{Budget, Control, Error, Job, Settings, Tile};
+
+/// Set by SIGINT/SIGTERM: finish the chunk in flight, save, exit 130.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// The job: from a checkpoint, or from the command line.
+fn job_of(args: &RenderArgs) -> Result<(Job, Option<veach::Film>), Error> {
+    if let Some(path) = &args.resume {
+        if args.look.any() {
+            return Err(Error::Input(
+                "--resume continues the saved render: camera, environment and lens flags cannot change it".into(),
+            ));
+        }
+        let (film, job) = veach::output::read_film(path)?;
+        return Ok((job, Some(film)));
+    }
+    let scene = args.scene.clone().ok_or_else(|| Error::Input("a SCENE is required".into()))?;
+    let (sample_start, sample_end) = args.sample_range.unwrap_or((0, args.spp));
+    if sample_end <= sample_start {
+        return Err(Error::Input("--spp must be at least 1".into()));
+    }
+    let mut settings = Settings {
+        width: args.width,
+        height: args.height,
+        max_depth: args.max_depth,
+        seed: args.seed,
+        strategy: args.strategy,
+        sampler: args.sampler,
+        tile: args.tile,
+        ..Settings::default()
+    };
+    args.look.apply(&mut settings);
+    settings.validate()?;
+    let scene = std::fs::canonicalize(&scene).unwrap_or(scene);
+    Ok((Job { scene, settings, sample_start, sample_end }, None))
+}
+
+pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
+    let t0 = Instant::now();
+    veach::output::check_output(&args.output)?;
+    for path in [&args.stats_json, &args.checkpoint].into_iter().flatten() {
+        veach::output::check_writable(path)?;
+    }
+    let (job, resumed) = job_of(args)?;
+    let loaded = veach::load(&job.scene, job.settings.camera.as_deref())?;
+    crate::warn_all(&job.scene, &loaded.warnings);
+    let triangles = loaded.scene.triangles.len();
+    let environment = job.settings.environment(&loaded.scene.environment)?;
+    if loaded.scene.emissive_triangle_count() == 0 && loaded.scene.punctual_lights.is_empty() && environment.is_black()
+    {
+        eprintln!(
+            "veach: warning: {}: the scene has no lights and no environment; the image will be black",
+            job.scene.display()
+        );
+    }
+    let packed = veach::PackedScene::new(&loaded.scene);
+    let (bvh_nodes, bvh_depth, bvh_seconds) = (packed.bvh_nodes, packed.bvh_depth, packed.bvh_build_seconds);
+    let mut renderer = crate::open_renderer(packed, &loaded.camera, &job.settings, args.backend)?;
+    let mut done = 0u32;
+    if let Some(film) = resumed {
+        done = film.samples().min(job.spp());
+        renderer.set_film(&film)?;
+    }
+    let total = job.spp();
+    let window = job.window();
+    let reference = match &args.reference {
+        Some(path) => Some(read_reference(path, window)?),
+        None => None,
+    };
+    let mut convergence = Vec::new();
+    // Ctrl-C and SIGTERM stop the loop between chunks; the work done is kept.
+    if let Err(e) = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst)) {
+        eprintln!("veach: warning: cannot catch Ctrl-C ({e}); an interrupted render will not be saved");
+    }
+
+    let bar = indicatif::ProgressBar::new(total as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{elapsed_precise} {wide_bar} {pos}/{len} spp  {msg}  ETA {eta}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_position(done as u64);
+    let pixels = window.width as f64 * window.height as f64;
+    let first = done;
+    let mut last_checkpoint = Instant::now();
+    let budget = Budget { time: None, cancel: Some(&INTERRUPTED), stop_at_powers_of_two: reference.is_some() };
+    let progress =
+        veach::render_progressive(&mut renderer, job.sample_start, done, total, budget, &mut |renderer, p| {
+            if let Some(r) = &reference
+                && (p.done.is_power_of_two() || p.finished())
+            {
+                let rmse = veach::metrics::rmse(&renderer.film()?, r);
+                convergence.push(serde_json::json!({"spp": p.done, "seconds": p.seconds, "rmse": rmse}));
+            }
+            bar.set_position(p.done as u64);
+            let rate = (p.done - first) as f64 * pixels / p.seconds.max(1e-9);
+            bar.set_message(format!("{:.2} Msamples/s", rate / 1e6));
+            if let Some(path) = &args.checkpoint
+                && last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every
+                && !p.finished()
+            {
+                veach::output::write(&renderer.film()?, path, 0.0, Some(&job))?;
+                last_checkpoint = Instant::now();
+            }
+            Ok(Control::Continue)
+        })?;
+    let done = progress.done;
+    let interrupted = done < total;
+    let film = renderer.film()?;
+    let seconds_render = progress.seconds;
+    bar.finish_and_clear();
+    veach::output::write_with(&film, &args.output, args.exposure, args.tonemap, Some(&job))?;
+    if let Some(path) = &args.checkpoint {
+        veach::output::write(&film, path, 0.0, Some(&job))?;
+    }
+    let nonfinite = film.nonfinite_samples();
+    if nonfinite > 0 {
+        eprintln!("veach: warning: dropped {nonfinite} non-finite samples");
+    }
+    let rendered = (done - first) as f64 * pixels;
+    let samples_per_second = rendered / seconds_render.max(1e-9);
+    if interrupted {
+        eprintln!("veach: interrupted: wrote {} with {done} of {total} spp", args.output.display());
+    } else {
+        eprintln!(
+            "veach: wrote {} ({}x{}, {} spp, {}, {:.2} s, {:.2} Msamples/s)",
+            args.output.display(),
+            window.width,
+            window.height,
+            total,
+            renderer.adapter_name(),
+            seconds_render,
+            samples_per_second / 1e6
+        );
+    }
+    if let Some(path) = &args.stats_json {
+        let s = &job.settings;
+        let stats = serde_json::json!({
+            "scene": job.scene.display().to_string(),
+            "width": s.width,
+            "height": s.height,
+            "tile": s.tile,
+            "spp": done,
+            "spp_target": total,
+            "sample_start": job.sample_start,
+            "interrupted": interrupted,
+            "max_depth": s.max_depth,
+            "seed": s.seed,
+            "strategy": s.strategy,
+            "sampler": s.sampler,
+            "adapter": renderer.adapter_name(),
+            "backend": format!("{:?}", renderer.backend()).to_lowercase(),
+            "seconds_total": t0.elapsed().as_secs_f64(),
+            "seconds_render": seconds_render,
+            "samples_per_second": samples_per_second,
+            "triangles": triangles,
+            "bvh_nodes": bvh_nodes,
+            "bvh_depth": bvh_depth,
+            "bvh_build_seconds": bvh_seconds,
+            "nonfinite_samples": nonfinite,
+            "gpu_bytes": renderer.gpu_bytes(),
+            "reference": args.reference.as_ref().map(|p| p.display().to_string()),
+            "convergence": convergence,
+        });
+        veach::output::write_atomic(path, serde_json::to_string_pretty(&stats).unwrap_or_default().as_bytes())?;
+    }
+    Ok(if interrupted { Outcome::Interrupted } else { Outcome::Done })
+}
+
+/// The reference image for --reference, as linear RGB per pixel of the render window.
+fn read_reference(path: &Path, window: Tile) -> Result<Vec<Vec3>, Error> {
+    let (w, h, v) = veach::output::read_exr(path)?;
+    if (w, h) != (window.width, window.height) {
+        return Err(Error::Input(format!(
+            "{}: the reference is {w}x{h}, the render {}x{}",
+            path.display(),
+            window.width,
+            window.height
+        )));
+    }
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err(Error::Input(format!("{}: the reference has non-finite pixels", path.display())));
+    }
+    Ok(v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect())
+}

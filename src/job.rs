@@ -1,0 +1,112 @@
+//! `Job`: a render as saved in every EXR veach writes (scene, settings, sample range), and the
+//! rules by which saved renders resume and merge.
+
+use crate::Error;
+use crate::film::Film;
+use crate::settings::{Settings, Tile};
+use std::path::{Path, PathBuf};
+
+/// Everything that defines a render: resumable from, and mergeable with, other parts.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Job {
+    pub scene: PathBuf,
+    #[serde(flatten)]
+    pub settings: Settings,
+    /// Sample indices `sample_start .. sample_end` make up this render.
+    pub sample_start: u32,
+    pub sample_end: u32,
+}
+
+impl Job {
+    /// The window rendered: the tile, or the whole image.
+    pub fn window(&self) -> Tile {
+        self.settings.window()
+    }
+
+    /// Samples per pixel this job asks for.
+    pub fn spp(&self) -> u32 {
+        self.sample_end.saturating_sub(self.sample_start)
+    }
+
+    /// Refuses a job no render can honour (a hostile or damaged file's metadata included).
+    pub fn validate(&self) -> Result<(), Error> {
+        self.settings.validate()?;
+        if self.sample_end <= self.sample_start {
+            return Err(Error::Input(format!("sample range {}..{} is empty", self.sample_start, self.sample_end)));
+        }
+        Ok(())
+    }
+
+    /// Whether parts of `self` and `other` belong to one image: everything that changes the
+    /// image must agree (the window and the sample range may differ). Names what differs.
+    pub fn compatible_with(&self, other: &Job) -> Result<(), String> {
+        if self.scene != other.scene {
+            return Err(format!("the scene differs ({} vs {})", self.scene.display(), other.scene.display()));
+        }
+        let (a, b) = (&self.settings, &other.settings);
+        let checks: [(&str, bool); 11] = [
+            ("camera", a.camera == b.camera),
+            ("image size", (a.width, a.height) == (b.width, b.height)),
+            ("max depth", a.max_depth == b.max_depth),
+            ("seed", a.seed == b.seed),
+            ("strategy", a.strategy == b.strategy),
+            ("sampler", a.sampler == b.sampler),
+            ("environment map", a.env_map == b.env_map),
+            ("environment color", a.env_color == b.env_color),
+            ("environment strength", a.env_strength.to_bits() == b.env_strength.to_bits()),
+            ("aperture", a.aperture.to_bits() == b.aperture.to_bits()),
+            ("focus distance", a.focus_distance.map(f32::to_bits) == b.focus_distance.map(f32::to_bits)),
+        ];
+        match checks.iter().find(|(_, same)| !same) {
+            Some((what, _)) => Err(format!("the {what} differs")),
+            None => Ok(()),
+        }
+    }
+}
+
+/// One saved part of a render: its film, its job and the file it came from (for messages).
+pub struct Part {
+    pub film: Film,
+    pub job: Job,
+    pub path: PathBuf,
+}
+
+/// Merges parts of one render (disjoint sample ranges, tiles, or both) into the film of the
+/// whole image, exactly; pixels no part rendered stay empty. Refuses parts of other renders,
+/// and parts whose samples overlap in a pixel.
+pub fn merge(parts: &[Part]) -> Result<(Film, Job), Error> {
+    let Some(first) = parts.first() else {
+        return Err(Error::Input("nothing to merge".into()));
+    };
+    let mut job = first.job.clone();
+    let (w, h) = (job.settings.width, job.settings.height);
+    let mut merged = Film::new(w, h);
+    let mut seen: Vec<(Tile, u32, u32, &Path)> = Vec::new();
+    for part in parts {
+        part.job.validate().map_err(|e| Error::Input(format!("{}: {e}", part.path.display())))?;
+        first.job.compatible_with(&part.job).map_err(|e| {
+            Error::Input(format!("{}: not a part of the render of {}: {e}", part.path.display(), first.path.display()))
+        })?;
+        let window = part.job.window();
+        let samples = part.film.samples();
+        let (start, end) = (part.job.sample_start, part.job.sample_start.saturating_add(samples));
+        for (t, s, e, other) in &seen {
+            if t.overlaps(&window) && *s < end && start < *e {
+                return Err(Error::Input(format!(
+                    "{}: its samples {start}..{end} overlap those of {} in the same pixels",
+                    part.path.display(),
+                    other.display()
+                )));
+            }
+        }
+        seen.push((window, start, end, &part.path));
+        merged
+            .merge_at(&part.film, window.x, window.y)
+            .map_err(|e| Error::Input(format!("{}: {e}", part.path.display())))?;
+        job.sample_start = job.sample_start.min(start);
+        job.sample_end = job.sample_end.max(end);
+    }
+    // The merged film covers the whole image.
+    job.settings.tile = None;
+    Ok((merged, job))
+}

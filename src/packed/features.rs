@@ -1,0 +1,46 @@
+//! Which optional parts of the kernel a scene needs: the shaders' override constants, and
+//! the run-time conditions of the CPU twin.
+
+use super::PackedScene;
+use super::layout::{Material, NO_TEXTURE, TRI_ALPHA};
+
+/// Which optional parts of the kernel a scene needs (the shaders' override constants).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Features {
+    pub alpha_test: bool,
+    pub textures: bool,
+    pub punctual_lights: bool,
+    pub transmission: bool,
+    pub instancing: bool,
+}
+
+impl Features {
+    /// The pipeline constants of `shaders/common.wgsl`.
+    pub fn constants(&self) -> [(&'static str, f64); 5] {
+        let f = |b: bool| if b { 1.0 } else { 0.0 };
+        [
+            ("ALPHA_TEST", f(self.alpha_test)),
+            ("TEXTURES", f(self.textures)),
+            ("PUNCTUAL_LIGHTS", f(self.punctual_lights)),
+            ("TRANSMISSION", f(self.transmission)),
+            ("INSTANCING", f(self.instancing)),
+        ]
+    }
+}
+
+impl PackedScene {
+    pub fn features(&self) -> Features {
+        let textured = |m: &Material| {
+            [m.base_color_texture, m.metallic_roughness_texture, m.emissive_texture, m.normal_texture]
+                .iter()
+                .any(|t| t.layer != NO_TEXTURE)
+        };
+        Features {
+            alpha_test: self.triangles.iter().any(|t| t.flags & TRI_ALPHA != 0),
+            textures: self.materials.iter().any(textured),
+            punctual_lights: self.punctual_count > 0,
+            transmission: self.materials.iter().any(|m| m.transmission > 0.0 || m.attenuation != [0.0; 3]),
+            instancing: self.instance_count > 0,
+        }
+    }
+}

@@ -1,0 +1,122 @@
+//! The records of the scene buffers as the kernel reads them. Each has a twin of the same
+//! name in `shaders/common.wgsl` with the same field order (std430, 16-byte rows);
+//! tests/layout.rs checks sizes and offsets with naga.
+
+use bytemuck::{Pod, Zeroable};
+
+/// A triangle as intersected: vertex 0 and two edges (Möller–Trumbore form).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct Triangle {
+    pub p0: [f32; 3],
+    pub material: u32,
+    pub e1: [f32; 3],
+    /// Probability of picking this triangle in light sampling divided by its area
+    /// (the area-measure light pdf); 0 when it is not a light.
+    pub light_pdf_area: f32,
+    pub e2: [f32; 3],
+    /// TRI_* bits.
+    pub flags: u32,
+}
+
+/// Has vertex normals (else the shading normal is the geometric normal).
+pub const TRI_HAS_NORMALS: u32 = 1;
+/// Has a tangent frame (its material has a normal map).
+pub const TRI_HAS_TANGENTS: u32 = 2;
+/// Its material's alpha (MASK or BLEND) decides whether a ray hits it.
+pub const TRI_ALPHA: u32 = 4;
+/// Bits 3, 4, 5: vertex 0, 1, 2's tangent has handedness −1.
+pub const TRI_TANGENT_SIGN_SHIFT: u32 = 3;
+/// Set on a triangle moved to world space by a mirroring instance (winding reversed).
+pub const TRI_MIRRORED: u32 = 64;
+
+/// Per-triangle vertex attributes: octahedron-encoded normals and tangents
+/// (`pack2x16snorm`) and TEXCOORD_0, one of each per vertex.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct Attributes {
+    pub n: [u32; 3],
+    pub t0: u32,
+    pub t12: [u32; 2],
+    pub uv: [[f32; 2]; 3],
+}
+
+/// A material's texture: layer of the texture array (NO_TEXTURE: none), UV transform rows,
+/// and mode bits (wrap s in bits 0–1, wrap t in 2–3, sRGB-encoded in bit 4).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct TextureRef {
+    pub row0: [f32; 3],
+    pub layer: u32,
+    pub row1: [f32; 3],
+    pub mode: u32,
+}
+
+pub const NO_TEXTURE: u32 = u32::MAX;
+pub const TEX_SRGB: u32 = 16;
+
+/// Material flags.
+pub const MAT_ALPHA_MASK: u32 = 1;
+pub const MAT_ALPHA_BLEND: u32 = 2;
+pub const MAT_DOUBLE_SIDED: u32 = 4;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct Material {
+    pub base_color: [f32; 3],
+    pub metallic: f32,
+    pub emission: [f32; 3],
+    pub roughness: f32,
+    /// Fresnel reflectance at normal incidence of the dielectric (non-metal) part:
+    /// ((ior − 1)/(ior + 1))² × specularColor, clamped to 1, × specularFactor.
+    pub dielectric_f0: [f32; 3],
+    pub ior: f32,
+    /// Grazing reflectance of the dielectric part (= specularFactor).
+    pub dielectric_f90: f32,
+    /// Share of the non-metal part that refracts (KHR_materials_transmission).
+    pub transmission: f32,
+    /// baseColorFactor alpha, and the MASK cutoff.
+    pub alpha: f32,
+    pub alpha_cutoff: f32,
+    /// Absorption coefficient inside (KHR_materials_volume): −ln(color) / distance.
+    pub attenuation: [f32; 3],
+    /// MAT_* bits.
+    pub flags: u32,
+    pub normal_scale: f32,
+    pub pad: [f32; 3],
+    pub base_color_texture: TextureRef,
+    pub metallic_roughness_texture: TextureRef,
+    pub emissive_texture: TextureRef,
+    pub normal_texture: TextureRef,
+}
+
+/// A KHR_lights_punctual light as four rows of the light-data buffer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct Punctual {
+    pub position: [f32; 3],
+    /// PUNCTUAL_* kind.
+    pub kind: f32,
+    pub direction: [f32; 3],
+    pub range: f32,
+    pub intensity: [f32; 3],
+    pub cos_inner: f32,
+    pub cos_outer: f32,
+    pub pad: [f32; 3],
+}
+
+pub const PUNCTUAL_POINT: f32 = 0.0;
+pub const PUNCTUAL_SPOT: f32 = 1.0;
+pub const PUNCTUAL_DIRECTIONAL: f32 = 2.0;
+
+/// One entry of the light alias table (Vose): pick entry `i` uniformly, keep it with
+/// probability `prob`, else take `alias`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct LightEntry {
+    pub triangle: u32,
+    pub alias_slot: u32,
+    pub prob: f32,
+    /// Probability that this light is chosen (for reference and tests).
+    pub pmf: f32,
+}

@@ -1,0 +1,67 @@
+//! Materials as the kernel reads them: glTF's metallic-roughness parameters, with the
+//! dielectric Fresnel terms of KHR_materials_ior/_specular folded in.
+
+use super::layout::{
+    MAT_ALPHA_BLEND, MAT_ALPHA_MASK, MAT_DOUBLE_SIDED, Material as PackedMaterial, NO_TEXTURE, TEX_SRGB,
+    TextureRef as PackedTextureRef,
+};
+use crate::scene::{AlphaMode, Material, TextureRef};
+use glam::Vec3;
+
+pub fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+pub fn pack_material(m: &Material) -> PackedMaterial {
+    let (cutoff, mut flags) = match m.alpha_mode {
+        AlphaMode::Opaque => (0.0, 0),
+        AlphaMode::Mask(c) => (c, MAT_ALPHA_MASK),
+        AlphaMode::Blend => (0.0, MAT_ALPHA_BLEND),
+    };
+    if m.double_sided {
+        flags |= MAT_DOUBLE_SIDED;
+    }
+    let attenuation = if m.attenuation_distance.is_finite() {
+        m.attenuation_color.max(Vec3::splat(1e-6)).map(|c| -c.ln() / m.attenuation_distance)
+    } else {
+        Vec3::ZERO
+    };
+    PackedMaterial {
+        base_color: m.base_color.into(),
+        metallic: m.metallic,
+        emission: m.emission.into(),
+        roughness: m.roughness,
+        dielectric_f0: dielectric_f0(m).into(),
+        ior: m.ior,
+        dielectric_f90: m.specular_factor,
+        transmission: m.transmission,
+        alpha: m.alpha,
+        alpha_cutoff: cutoff,
+        attenuation: attenuation.into(),
+        flags,
+        normal_scale: m.normal_scale,
+        pad: [0.0; 3],
+        base_color_texture: pack_texture_ref(m.base_color_texture, true),
+        metallic_roughness_texture: pack_texture_ref(m.metallic_roughness_texture, false),
+        emissive_texture: pack_texture_ref(m.emissive_texture, true),
+        normal_texture: pack_texture_ref(m.normal_texture, false),
+    }
+}
+
+fn pack_texture_ref(t: Option<TextureRef>, srgb: bool) -> PackedTextureRef {
+    match t {
+        None => PackedTextureRef { row0: [1.0, 0.0, 0.0], layer: NO_TEXTURE, row1: [0.0, 1.0, 0.0], mode: 0 },
+        Some(t) => PackedTextureRef {
+            row0: t.transform[0],
+            layer: t.texture,
+            row1: t.transform[1],
+            mode: t.wrap[0] as u32 | (t.wrap[1] as u32) << 2 | if srgb { TEX_SRGB } else { 0 },
+        },
+    }
+}
+
+/// The dielectric F0 of glTF's metallic-roughness model with KHR_materials_specular/_ior.
+pub fn dielectric_f0(m: &Material) -> Vec3 {
+    let r = (m.ior - 1.0) / (m.ior + 1.0);
+    (r * r * m.specular_color).min(Vec3::ONE) * m.specular_factor
+}

@@ -1,0 +1,173 @@
+//! The packed scene: the exact buffers the GPU reads, and the CPU reference reads too.
+//!
+//! `layout` holds the records (twins of `shaders/common.wgsl`); the other files pack one
+//! kind of scene data each. The node buffer's slot layout is described in `accel`.
+
+mod environment;
+mod features;
+mod geometry;
+mod instances;
+pub mod layout;
+mod lights;
+mod materials;
+mod octahedral;
+mod textures;
+
+pub use crate::accel::{BvhNode, CwNode, INSTANCE_MIRRORED, Instance};
+pub use features::Features;
+pub use layout::*;
+pub use materials::{dielectric_f0, luminance, pack_material};
+pub use octahedral::{oct_decode, oct_encode};
+pub use textures::{MAX_TEXTURE_LAYER_SIDE, TEXTURE_BUDGET_BYTES, texture_layer_side};
+
+use crate::accel::{self, cw_slots};
+use crate::scene::{Environment, Scene};
+use bytemuck::Zeroable;
+use environment::pack_environment;
+use geometry::{pack_attributes, pack_triangle};
+use glam::Vec3;
+use instances::build_instances;
+use lights::{build_alias_table, pack_punctual};
+use textures::pack_textures;
+
+#[derive(Clone)]
+pub struct PackedScene {
+    /// BVH nodes in BvhNode-sized slots. Without instances: the mesh's CWBVH (CwNode, three
+    /// slots each) from slot 0. With instances: the top-level BVH2 over instances from slot 0,
+    /// then the world mesh's and each stored mesh's CWBVH (starting at a multiple of three
+    /// slots), then the instance records (four slots each, from `instance_base`).
+    pub nodes: Vec<BvhNode>,
+    pub instance_base: u32,
+    /// Instance records, the world mesh's (identity) included; 0 without instancing.
+    pub instance_count: u32,
+    pub triangles: Vec<Triangle>,
+    pub attributes: Vec<Attributes>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<LightEntry>,
+    /// Original scene index of each packed triangle.
+    pub order: Vec<u32>,
+    pub bvh_build_seconds: f64,
+    /// BVH nodes: the meshes' CWBVH nodes and the top level's BVH2 nodes.
+    pub bvh_nodes: usize,
+    /// Levels of the deepest mesh BVH (see accel::MAX_DEPTH).
+    pub bvh_depth: u32,
+    /// Constant environment radiance, or the tint of the environment map.
+    pub environment: Vec3,
+    /// The scene's own environment (what settings without environment flags render).
+    pub scene_environment: Environment,
+    /// The light-data buffer: environment map texels (rgb, conditional CDF of the row up to
+    /// this texel), then one row per map row (marginal CDF up to this row, 0, 0, 0); one
+    /// zeroed row when there is no map. The punctual lights follow, four rows each, from
+    /// `punctual_base`. One buffer because lavapipe binds at most 8 storage buffers.
+    pub light_data: Vec<[f32; 4]>,
+    /// The punctual lights (also in `light_data`), kept to rebuild it for a new environment.
+    pub punctuals: Vec<Punctual>,
+    pub punctual_base: u32,
+    pub punctual_count: u32,
+    /// Texture array: `texture_layers` square layers of `texture_size`² RGBA8 texels (one
+    /// u32 each, R in the low byte), row-major, layer after layer. At least one layer.
+    pub texels: Vec<u32>,
+    pub texture_size: u32,
+    pub texture_layers: u32,
+    pub env_width: u32,
+    pub env_height: u32,
+    /// Σ luminance × sin θ over all texels: the normaliser of the sampling pmf.
+    pub env_total: f32,
+    /// Scene bounds' diagonal length (scale for ray epsilons where needed).
+    pub extent: f32,
+}
+
+impl PackedScene {
+    pub fn new(scene: &Scene) -> PackedScene {
+        let verts: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.positions).collect();
+        let bvh = accel::build(&verts);
+        let ordered: Vec<&crate::scene::Triangle> = bvh.order.iter().map(|&i| &scene.triangles[i as usize]).collect();
+
+        let materials: Vec<Material> = scene.materials.iter().map(pack_material).collect();
+
+        // Lights: emissive triangles with positive area, chosen proportional to power.
+        let mut light_tris = Vec::new();
+        let mut weights = Vec::new();
+        for (i, t) in ordered.iter().enumerate() {
+            let m = &scene.materials[t.material as usize];
+            let area = t.area();
+            let power = area * luminance(m.emission);
+            if m.is_emissive() && area > 0.0 && power.is_finite() && power > 0.0 {
+                light_tris.push(i as u32);
+                weights.push(power as f64);
+            }
+        }
+        let lights = build_alias_table(&light_tris, &weights);
+        let mut light_pdf = vec![0.0f32; ordered.len()];
+        for l in &lights {
+            let area = ordered[l.triangle as usize].area();
+            light_pdf[l.triangle as usize] = l.pmf / area;
+        }
+
+        let mut triangles: Vec<Triangle> =
+            ordered.iter().zip(&light_pdf).map(|(t, &pdf)| pack_triangle(scene, t, pdf)).collect();
+        if triangles.is_empty() {
+            // No triangle is referenced (the empty BVH's root has no children), but a storage
+            // binding needs at least one element.
+            triangles.push(Triangle::zeroed());
+        }
+        let mut attributes: Vec<Attributes> = ordered.iter().map(|t| pack_attributes(t)).collect();
+        attributes.resize(triangles.len(), Attributes::zeroed());
+        let (nodes, instance_base, build_seconds, bvh_nodes, bvh_depth) = if scene.instances.is_empty() {
+            (cw_slots(&bvh.nodes), 0, bvh.build_seconds, bvh.nodes.len(), bvh.depth)
+        } else {
+            build_instances(scene, bvh.nodes, bvh.depth, &mut triangles, &mut attributes, bvh.build_seconds)
+        };
+        let nodes_len = nodes.len();
+        let punctuals: Vec<Punctual> = scene.punctual_lights.iter().map(pack_punctual).collect();
+        let (texels, texture_size, texture_layers) = pack_textures(&scene.textures);
+        let bounds = scene.bounds();
+        let extent = if bounds.is_empty() { 1.0 } else { bounds.diagonal().length() };
+        let mut packed = PackedScene {
+            nodes,
+            instance_base,
+            instance_count: if scene.instances.is_empty() {
+                0
+            } else {
+                (nodes_len - instance_base as usize) as u32 / 4
+            },
+            triangles,
+            attributes,
+            materials,
+            lights,
+            order: bvh.order,
+            bvh_build_seconds: build_seconds,
+            bvh_nodes,
+            bvh_depth,
+            environment: Vec3::ZERO,
+            scene_environment: scene.environment.clone(),
+            light_data: Vec::new(),
+            punctuals,
+            punctual_base: 0,
+            punctual_count: scene.punctual_lights.len() as u32,
+            texels,
+            texture_size,
+            texture_layers,
+            env_width: 0,
+            env_height: 0,
+            env_total: 0.0,
+            extent,
+        };
+        packed.set_environment(&scene.environment);
+        packed
+    }
+
+    /// Replaces the environment (map and radiance) without touching geometry: the light-data
+    /// buffer is rebuilt, the BVH is not.
+    pub fn set_environment(&mut self, environment: &Environment) {
+        let (mut rows, w, h, total) = match &environment.map {
+            Some(map) => pack_environment(map),
+            None => (vec![[0.0; 4]], 0, 0, 0.0),
+        };
+        self.punctual_base = rows.len() as u32;
+        rows.extend_from_slice(bytemuck::cast_slice::<Punctual, [f32; 4]>(&self.punctuals));
+        self.light_data = rows;
+        (self.env_width, self.env_height, self.env_total) = (w, h, total);
+        self.environment = environment.radiance;
+    }
+}

@@ -1,0 +1,226 @@
+//! `Renderer`: a packed scene on one engine (the GPU kernel or the CPU reference),
+//! accumulating samples progressively into a film.
+
+use crate::film::Film;
+use crate::packed::PackedScene;
+use crate::params::Params;
+use crate::scene::{Camera, Environment};
+use crate::settings::{Backend, Settings, Tile};
+use crate::{Error, accel, cpu, gpu};
+
+/// The render parameters of `settings` for `camera`, with the lens set up.
+fn make_params(scene: &PackedScene, camera: &Camera, settings: &Settings, tile: Tile) -> Params {
+    let mut params = Params::new(camera, settings, tile, scene);
+    if settings.aperture > 0.0 {
+        params.aperture = settings.aperture;
+        // Autofocus is a host-side ray query on the CPU BVH.
+        params.focus_distance = settings.focus_distance.unwrap_or_else(|| cpu::camera::autofocus(scene, &params));
+    }
+    params
+}
+
+enum Engine {
+    /// The GPU engine, and the host copy of the scene for host ray queries.
+    Gpu(Box<gpu::GpuRenderer>, PackedScene),
+    Cpu(Box<cpu::Renderer>),
+}
+
+/// A scene ready to render with one engine, accumulating samples progressively.
+pub struct Renderer {
+    params: Params,
+    settings: Settings,
+    engine: Engine,
+}
+
+impl Renderer {
+    /// Prepares `scene` for rendering on `backend` (opening a GPU device for `Backend::Gpu`).
+    pub fn new(scene: PackedScene, camera: &Camera, settings: &Settings, backend: Backend) -> Result<Renderer, Error> {
+        match backend {
+            Backend::Cpu => Self::build(scene, camera, settings, None),
+            Backend::Gpu => Self::build(scene, camera, settings, Some(gpu::GpuContext::new()?)),
+        }
+    }
+
+    /// Prepares `scene` for the GPU engine on an open device.
+    pub fn with_context(
+        scene: PackedScene,
+        camera: &Camera,
+        settings: &Settings,
+        ctx: gpu::GpuContext,
+    ) -> Result<Renderer, Error> {
+        Self::build(scene, camera, settings, Some(ctx))
+    }
+
+    fn build(
+        mut scene: PackedScene,
+        camera: &Camera,
+        settings: &Settings,
+        ctx: Option<gpu::GpuContext>,
+    ) -> Result<Renderer, Error> {
+        settings.validate()?;
+        if scene.bvh_depth > accel::MAX_DEPTH {
+            return Err(Error::Limit(format!(
+                "the scene's BVH is {} levels deep; traversal walks at most {}",
+                scene.bvh_depth,
+                accel::MAX_DEPTH
+            )));
+        }
+        let environment = settings.environment(&scene.scene_environment)?;
+        scene.set_environment(&environment);
+        let params = make_params(&scene, camera, settings, settings.window());
+        let engine = match ctx {
+            None => Engine::Cpu(Box::new(cpu::Renderer::new(scene, params))),
+            Some(ctx) => Engine::Gpu(Box::new(gpu::GpuRenderer::new(ctx, &scene, params)?), scene),
+        };
+        Ok(Renderer { params, settings: settings.clone(), engine })
+    }
+
+    pub fn backend(&self) -> Backend {
+        match self.engine {
+            Engine::Gpu(..) => Backend::Gpu,
+            Engine::Cpu(_) => Backend::Cpu,
+        }
+    }
+
+    /// The engine and its device, for logs and statistics.
+    pub fn adapter_name(&self) -> String {
+        match &self.engine {
+            Engine::Gpu(g, _) => g.adapter_name(),
+            Engine::Cpu(_) => format!("cpu ({} threads)", rayon::current_num_threads()),
+        }
+    }
+
+    /// The packed scene (host copy), for host ray queries and statistics.
+    pub fn scene(&self) -> &PackedScene {
+        match &self.engine {
+            Engine::Gpu(_, scene) => scene,
+            Engine::Cpu(c) => c.scene(),
+        }
+    }
+
+    #[doc(hidden)]
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Bytes of device memory held (0 on the CPU engine).
+    pub fn gpu_bytes(&self) -> u64 {
+        match &self.engine {
+            Engine::Gpu(g, _) => g.gpu_bytes,
+            Engine::Cpu(_) => 0,
+        }
+    }
+
+    /// Accumulates sample indices `start .. start + count` into the film.
+    pub fn render_samples(&mut self, start: u32, count: u32) -> Result<(), Error> {
+        if start.checked_add(count).is_none() {
+            return Err(Error::Input(format!("sample indices {start}+{count} overflow")));
+        }
+        match &mut self.engine {
+            Engine::Gpu(g, _) => g.render_samples(start, count),
+            Engine::Cpu(c) => {
+                c.render_samples(start, count);
+                Ok(())
+            }
+        }
+    }
+
+    /// Accumulates sample `sample` for film rows `y0 .. y0 + rows` only: the viewer's way to
+    /// keep each frame short. `y0` and `rows` must be multiples of `ROW_BAND`.
+    pub fn render_rows(&mut self, sample: u32, y0: u32, rows: u32) -> Result<(), Error> {
+        if !y0.is_multiple_of(ROW_BAND) || !rows.is_multiple_of(ROW_BAND) {
+            return Err(Error::Input(format!("row band {y0}+{rows} is not aligned to {ROW_BAND} rows")));
+        }
+        match &mut self.engine {
+            Engine::Gpu(g, _) => g.render_rows(sample, y0, rows),
+            Engine::Cpu(c) => {
+                c.render_rows(sample, y0, rows);
+                Ok(())
+            }
+        }
+    }
+
+    /// The accumulated film (a readback on the GPU).
+    pub fn film(&self) -> Result<Film, Error> {
+        match &self.engine {
+            Engine::Gpu(g, _) => g.read_film(),
+            Engine::Cpu(c) => Ok(c.film().clone()),
+        }
+    }
+
+    /// Restarts accumulation with a new camera and settings (same scene and environment):
+    /// the viewer's reset.
+    pub fn reset(&mut self, camera: &Camera, settings: &Settings) -> Result<(), Error> {
+        settings.validate()?;
+        let params = make_params(self.scene(), camera, settings, settings.window());
+        match &mut self.engine {
+            Engine::Gpu(g, _) => g.reset(params)?,
+            Engine::Cpu(c) => c.reset(params),
+        }
+        (self.params, self.settings) = (params, settings.clone());
+        Ok(())
+    }
+
+    /// Replaces the environment (a new sky keeps the BVH and the device's geometry) and
+    /// restarts accumulation.
+    pub fn set_environment(&mut self, camera: &Camera, environment: &Environment) -> Result<(), Error> {
+        let window = self.settings.window();
+        match &mut self.engine {
+            Engine::Gpu(g, scene) => {
+                scene.set_environment(environment);
+                self.params = make_params(scene, camera, &self.settings, window);
+                g.set_environment(scene, self.params)?;
+            }
+            Engine::Cpu(c) => {
+                c.set_environment(environment);
+                self.params = make_params(c.scene(), camera, &self.settings, window);
+                c.reset(self.params);
+            }
+        }
+        Ok(())
+    }
+
+    /// A host ray query: the depth along the view direction of what the centre of film pixel
+    /// `pixel` sees (through a pinhole), or None when it sees the sky. The viewer's
+    /// click-to-focus.
+    pub fn pick_depth(&self, pixel: glam::UVec2) -> Option<f32> {
+        let params = Params { aperture: 0.0, ..self.params };
+        let mut sampler = cpu::sampler::sampler_init(cpu::sampler::SAMPLER_INDEPENDENT, 0, 0, 0);
+        let ray = cpu::camera::generate_ray(&params, pixel, glam::Vec2::splat(0.5), &mut sampler);
+        let hit = cpu::bvh::intersect_closest(self.scene(), &ray);
+        (hit.tri != cpu::bvh::NO_HIT).then(|| hit.t * ray.dir.dot(glam::Vec3::from(params.cam_forward)))
+    }
+
+    /// The GPU engine, when rendering there (the viewer displays its film in place).
+    pub fn gpu(&self) -> Option<&gpu::GpuRenderer> {
+        match &self.engine {
+            Engine::Gpu(g, _) => Some(g),
+            Engine::Cpu(_) => None,
+        }
+    }
+
+    /// Replaces the accumulated film (resume); it must match the render window.
+    pub fn set_film(&mut self, film: &Film) -> Result<(), Error> {
+        let w = self.settings.window();
+        if (film.width, film.height) != (w.width, w.height)
+            || film.data.len() != Film::new(w.width, w.height).data.len()
+        {
+            return Err(Error::Input(format!(
+                "a {}x{} film does not fit the {}x{} render window",
+                film.width, film.height, w.width, w.height
+            )));
+        }
+        match &mut self.engine {
+            Engine::Gpu(g, _) => g.upload_film(film),
+            Engine::Cpu(c) => c.set_film(film),
+        }
+        Ok(())
+    }
+}
+
+/// Rows of one band of `Renderer::render_rows`: the kernel's workgroup height.
+pub const ROW_BAND: u32 = 8;

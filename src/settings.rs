@@ -1,0 +1,210 @@
+//! What a user chooses about a render, in one type validated in one place.
+
+use crate::Error;
+use glam::Vec3;
+use std::path::PathBuf;
+
+/// Veach's four direct-lighting estimators.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+#[repr(u32)]
+pub enum Strategy {
+    /// BSDF sampling only: emission counts when a BSDF-sampled ray hits an emitter.
+    Bsdf = 0,
+    /// Light sampling only: BSDF rays continue the path but their emitter hits count nothing.
+    Light = 1,
+    /// One light and one BSDF sample, weighted by the balance heuristic.
+    MisBalance = 2,
+    /// One light and one BSDF sample, weighted by the power heuristic.
+    MisPower = 3,
+}
+
+impl Strategy {
+    pub const ALL: [Strategy; 4] = [Strategy::Bsdf, Strategy::Light, Strategy::MisBalance, Strategy::MisPower];
+
+    /// The label of contact sheets and the viewer.
+    pub fn label(self) -> &'static str {
+        match self {
+            Strategy::Bsdf => "BSDF",
+            Strategy::Light => "LIGHT",
+            Strategy::MisBalance => "MIS BALANCE",
+            Strategy::MisPower => "MIS POWER",
+        }
+    }
+}
+
+impl TryFrom<u32> for Strategy {
+    type Error = Error;
+    fn try_from(v: u32) -> Result<Strategy, Error> {
+        Strategy::ALL.into_iter().find(|s| *s as u32 == v).ok_or_else(|| Error::Input(format!("no strategy {v}")))
+    }
+}
+
+/// How the numbers of a path's decisions are generated (`shaders/sampler.wgsl`); the
+/// discriminants are the shaders' `SAMPLER_*` ids.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+#[repr(u32)]
+pub enum SamplerKind {
+    /// Independent uniform numbers (PCG); the default of renders saved before samplers existed.
+    #[default]
+    Independent = 0,
+    /// Owen-scrambled Sobol', padded per 2D pair: lower error at equal spp.
+    Sobol = 1,
+}
+
+/// Which engine renders: the WGSL kernel through wgpu, or the CPU reference.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+pub enum Backend {
+    Gpu,
+    Cpu,
+}
+
+/// A crop window of the image (the whole image by default).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Tile {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Tile {
+    /// Whether the tile is non-empty and lies inside a `width`×`height` image (no overflow).
+    pub fn fits(&self, width: u32, height: u32) -> bool {
+        let inside = |o: u32, n: u32, side: u32| n > 0 && o.checked_add(n).is_some_and(|end| end <= side);
+        inside(self.x, self.width, width) && inside(self.y, self.height, height)
+    }
+
+    pub fn overlaps(&self, o: &Tile) -> bool {
+        let span = |a: u32, n: u32| a as u64..a as u64 + n as u64;
+        let (ax, ay, bx, by) =
+            (span(self.x, self.width), span(self.y, self.height), span(o.x, o.width), span(o.y, o.height));
+        ax.start < bx.end && bx.start < ax.end && ay.start < by.end && by.start < ay.end
+    }
+}
+
+/// Largest image side accepted (a GPU texture/dispatch-friendly bound).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// Largest film held in memory (CPU) before asking for tiles.
+pub const MAX_FILM_BYTES: u64 = 2 << 30;
+
+/// Everything a user chooses about a render. Saved (with the scene and the sample range, as
+/// a [`crate::Job`]) in every EXR veach writes, so renders resume and merge.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Settings {
+    /// Camera node name (None: the first camera, else a view framing the scene).
+    pub camera: Option<String>,
+    pub width: u32,
+    pub height: u32,
+    /// Longest path in segments (Mitsuba's max_depth); 0: no limit.
+    pub max_depth: u32,
+    pub seed: u32,
+    pub strategy: Strategy,
+    /// An equirectangular environment map (.hdr/.exr) replacing the scene's environment.
+    pub env_map: Option<PathBuf>,
+    /// Constant environment radiance, or the tint of `env_map` (None: the scene's own, or
+    /// white under a map).
+    pub env_color: Option<[f32; 3]>,
+    /// Scales the environment.
+    pub env_strength: f32,
+    /// The crop window rendered (None: the whole image).
+    pub tile: Option<Tile>,
+    /// Thin-lens radius in scene units (0: a pinhole camera).
+    #[serde(default)]
+    pub aperture: f32,
+    /// Distance in focus; None with an aperture: what the image centre sees.
+    #[serde(default)]
+    pub focus_distance: Option<f32>,
+    /// Renders saved before samplers existed used independent numbers.
+    #[serde(default)]
+    pub sampler: SamplerKind,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            camera: None,
+            width: 512,
+            height: 512,
+            max_depth: 8,
+            seed: 0,
+            strategy: Strategy::MisPower,
+            env_map: None,
+            env_color: None,
+            env_strength: 1.0,
+            tile: None,
+            aperture: 0.0,
+            focus_distance: None,
+            sampler: SamplerKind::Sobol,
+        }
+    }
+}
+
+impl Settings {
+    /// The window rendered: the tile, or the whole image.
+    pub fn window(&self) -> Tile {
+        self.tile.unwrap_or(Tile { x: 0, y: 0, width: self.width, height: self.height })
+    }
+
+    /// Refuses settings no render can honour, naming the setting.
+    pub fn validate(&self) -> Result<(), Error> {
+        let (w, h) = (self.width, self.height);
+        if w == 0 || h == 0 || w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE {
+            return Err(Error::Limit(format!("image size {w}x{h} is outside 1..={MAX_IMAGE_SIDE} per side")));
+        }
+        let t = self.window();
+        if !t.fits(w, h) {
+            return Err(Error::Input(format!(
+                "tile {},{},{},{} does not fit in the {w}x{h} image",
+                t.x, t.y, t.width, t.height
+            )));
+        }
+        let film_bytes = t.width as u64 * t.height as u64 * (crate::film::WORDS_PER_PIXEL * 4) as u64;
+        if film_bytes > MAX_FILM_BYTES {
+            return Err(Error::Limit(format!(
+                "a {}x{} film needs {film_bytes} bytes, above veach's limit of {MAX_FILM_BYTES} bytes; render tiles (--tile)",
+                t.width, t.height
+            )));
+        }
+        if !self.aperture.is_finite() || self.aperture < 0.0 {
+            return Err(Error::Input(format!("aperture {}: expected a finite radius ≥ 0", self.aperture)));
+        }
+        if let Some(d) = self.focus_distance
+            && !(d.is_finite() && d > 0.0)
+        {
+            return Err(Error::Input(format!("focus distance {d}: expected a finite distance > 0")));
+        }
+        if !self.env_strength.is_finite() || self.env_strength < 0.0 {
+            return Err(Error::Input(format!(
+                "environment strength {}: expected a finite value ≥ 0",
+                self.env_strength
+            )));
+        }
+        if let Some(c) = self.env_color
+            && !c.iter().all(|v| v.is_finite() && *v >= 0.0)
+        {
+            return Err(Error::Input(format!("environment color {c:?}: expected finite values ≥ 0")));
+        }
+        Ok(())
+    }
+
+    /// The environment these settings ask for over a scene whose own is `scene`: a map
+    /// (loaded here) tinted by the color, a color, or the scene's, each scaled by the strength.
+    pub fn environment(&self, scene: &crate::scene::Environment) -> Result<crate::scene::Environment, Error> {
+        let color = self.env_color.map(Vec3::from);
+        let mut env = match &self.env_map {
+            Some(path) => crate::scene::Environment {
+                map: Some(std::sync::Arc::new(crate::scene::EnvironmentMap::load(path)?)),
+                radiance: color.unwrap_or(Vec3::ONE),
+            },
+            None => crate::scene::Environment { map: scene.map.clone(), radiance: color.unwrap_or(scene.radiance) },
+        };
+        env.radiance *= self.env_strength;
+        Ok(env)
+    }
+}
