@@ -21,7 +21,7 @@ fn make_params(scene: &PackedScene, camera: &Camera, settings: &Settings, tile: 
 
 enum Engine {
     /// The GPU engine, and the host copy of the scene for host ray queries.
-    Gpu(Box<gpu::GpuRenderer>, PackedScene),
+    Gpu(Box<gpu::GpuRenderer>, Box<PackedScene>),
     Cpu(Box<cpu::Renderer>),
 }
 
@@ -70,7 +70,7 @@ impl Renderer {
         let params = make_params(&scene, camera, settings, settings.window());
         let engine = match ctx {
             None => Engine::Cpu(Box::new(cpu::Renderer::new(scene, params))),
-            Some(ctx) => Engine::Gpu(Box::new(gpu::GpuRenderer::new(ctx, &scene, params)?), scene),
+            Some(ctx) => Engine::Gpu(Box::new(gpu::GpuRenderer::new(ctx, &scene, params)?), Box::new(scene)),
         };
         Ok(Renderer { params, settings: settings.clone(), engine })
     }

@@ -2,7 +2,8 @@
 
 use glam::{Mat3, Vec3};
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[repr(u32)]
 pub enum Tonemap {
     /// Exposure, then clamp to [0, 1].

@@ -1,6 +1,7 @@
-//! Every third-party model in ../shared/models loads and renders with finite, plausible
-//! pixels on the GPU (the CPU reference when there is no GPU). The folder is not part of the
-//! repository: without it these tests say so and pass.
+//! Every third-party model in ../shared/models loads (or is refused with a one-line error
+//! naming the extensions it requires) and renders with finite, plausible pixels on both
+//! engines: 0 non-finite samples. The folder is not part of the repository: without it these
+//! tests report themselves skipped, unless VEACH_REQUIRE_MODELS=1 (CI), where that fails.
 
 mod common;
 
@@ -12,7 +13,10 @@ fn models_dir() -> Option<PathBuf> {
     if d.is_dir() {
         Some(d)
     } else {
-        eprintln!("skipping: {} is absent (third-party models are not in the repository)", d.display());
+        if std::env::var("VEACH_REQUIRE_MODELS").as_deref() == Ok("1") {
+            panic!("VEACH_REQUIRE_MODELS=1 but {} is absent", d.display());
+        }
+        eprintln!("SKIPPED: {} is absent (third-party models are not in the repository)", d.display());
         None
     }
 }
@@ -40,30 +44,49 @@ fn every_shared_model_renders_finite_and_plausible() {
     let files = model_files(&dir);
     assert!(files.len() >= 8, "expected the shared models, found {files:?}");
     let ctx = common::gpu("every_shared_model_renders_finite_and_plausible");
+    let mut refused = Vec::new();
     for path in files {
-        let (scene, camera) = common::load_pair(&path, None).unwrap_or_else(|e| panic!("{e}"));
-        for w in &scene.warnings {
+        let loaded = match veach::load(&path, None) {
+            Ok(l) => l,
+            // Support for these extensions is tracked in its own issues; refusing them with
+            // a clear message is the behaviour until then.
+            Err(e) if e.to_string().contains("requires glTF extensions veach does not support") => {
+                assert!(!e.to_string().contains('\n'), "{e}");
+                refused.push(format!("{e}"));
+                continue;
+            }
+            Err(e) => panic!("{e}"),
+        };
+        for w in &loaded.warnings {
             eprintln!("{}: warning: {w}", path.display());
         }
-        let packed = veach::packed::PackedScene::new(&scene);
+        let packed = veach::packed::PackedScene::new(&loaded.scene);
         // A white sky, so that models without lights are seen.
         let settings =
             Settings { width: 64, height: 64, max_depth: 6, env_color: Some([1.0; 3]), ..Settings::default() };
-        let mut r = common::renderer(packed, &camera, &settings, ctx.clone()).unwrap();
-        r.render_samples(0, 4).unwrap();
-        let film = r.film().unwrap();
-        assert_eq!(film.nonfinite_samples(), 0, "{}: non-finite samples", path.display());
-        let n = film.pixel_count();
-        let mean: f32 = (0..n).map(|i| veach::packed::luminance(film.mean(i))).sum::<f32>() / n as f32;
-        let blown = (0..n).filter(|&i| film.mean(i).max_element() > 100.0).count();
-        eprintln!(
-            "{}: {} triangles, {} textures, mean {mean:.3}",
-            path.display(),
-            scene.triangles.len(),
-            scene.textures.len()
-        );
-        assert!(mean > 0.02 && mean < 20.0, "{}: implausible image mean {mean}", path.display());
-        assert!(blown * 100 < n, "{}: {blown} of {n} pixels above 100", path.display());
+        for ctx in [None, ctx.clone()].into_iter().enumerate().filter(|(k, c)| *k == 0 || c.is_some()).map(|(_, c)| c) {
+            let engine = if ctx.is_some() { "gpu" } else { "cpu" };
+            let mut r = common::renderer(packed.clone(), &loaded.camera, &settings, ctx).unwrap();
+            r.render_samples(0, 4).unwrap();
+            let film = r.film().unwrap();
+            let n = film.pixel_count();
+            let mean: f32 = (0..n).map(|i| veach::packed::luminance(film.mean(i))).sum::<f32>() / n as f32;
+            let blown = (0..n).filter(|&i| film.mean(i).max_element() > 100.0).count();
+            eprintln!(
+                "{} ({engine}): {} triangles, {} textures, mean {mean:.3}, {} non-finite",
+                path.display(),
+                loaded.scene.triangles.len(),
+                loaded.scene.textures.len(),
+                film.nonfinite_samples()
+            );
+            assert_eq!(film.nonfinite_samples(), 0, "{} ({engine}): non-finite samples", path.display());
+            assert!(mean > 0.02 && mean < 20.0, "{} ({engine}): implausible image mean {mean}", path.display());
+            assert!(blown * 100 < n, "{} ({engine}): {blown} of {n} pixels above 100", path.display());
+        }
+    }
+    eprintln!("refused (unsupported required extensions): {}", refused.len());
+    for r in &refused {
+        eprintln!("  {r}");
     }
 }
 

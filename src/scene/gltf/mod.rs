@@ -1,5 +1,7 @@
 //! glTF 2.0 import (.gltf and .glb) into a flat world-space `Scene`.
 
+mod resources;
+
 use super::tangents::generate_tangents;
 use super::{AlphaMode, Camera, Material, PunctualKind, PunctualLight, Scene, Texture, TextureRef, Triangle, Wrap};
 use crate::Error;
@@ -55,34 +57,46 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
 }
 
 /// Loads a .gltf or .glb held in memory; external files resolve against `base` (none: only
-/// embedded data). Errors are the problem alone, without the file name.
+/// embedded data, GLB chunks and data: URIs). Errors are the problem alone, without the file
+/// name.
 pub fn load_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
-    let json = if bytes.starts_with(b"glTF") { glb_json_chunk(bytes)? } else { bytes };
-    let raw: serde_json::Value = serde_json::from_slice(json).map_err(|e| format!("invalid glTF JSON: {e}"))?;
+    let (json, blob) = if bytes.starts_with(b"glTF") { glb_chunks(bytes)? } else { (bytes, None) };
+    let mut raw: serde_json::Value = serde_json::from_slice(json).map_err(|e| format!("invalid glTF JSON: {e}"))?;
     let mut warnings = Vec::new();
     check_extensions(&raw, &mut warnings)?;
-    let gltf = contained(|| gltf::Gltf::from_slice(bytes))?.map_err(|e| describe(&e))?;
-    for buffer in gltf.document.buffers() {
+    normalise(&mut raw);
+    let root: gltf::json::Root = serde_json::from_value(raw).map_err(|e| format!("invalid glTF JSON: {e}"))?;
+    let document = contained(|| gltf::Document::from_json(root))?.map_err(|e| describe(&e))?;
+    for buffer in document.buffers() {
         if buffer.length() as u64 > MAX_FILE_BYTES {
             return Err(format!("buffer {} declares {} bytes, above the limit", buffer.index(), buffer.length()));
         }
     }
-    let blob = gltf.blob.clone();
-    let buffers = contained(|| gltf::import_buffers(&gltf.document, base.or(Some(Path::new("."))), blob))?
-        .map_err(|e| describe(&e))?;
-    let base = base.or(Some(Path::new(".")));
-    let mut scene = contained(|| from_document(&gltf.document, &buffers, base, &mut warnings))??;
+    let base = resources::Base(base);
+    let buffers = resources::load_buffers(&document, blob, base)?;
+    let mut scene = from_document(&document, &buffers, base, &mut warnings)?;
     scene.warnings = warnings;
     Ok(scene)
+}
+
+/// Fills in what glTF lets a file leave out but the gltf crate's schema requires, so that
+/// valid files load: a scene without `nodes` is an empty scene.
+fn normalise(raw: &mut serde_json::Value) {
+    if let Some(scenes) = raw.get_mut("scenes").and_then(|s| s.as_array_mut()) {
+        for scene in scenes.iter_mut().filter_map(|s| s.as_object_mut()) {
+            scene.entry("nodes").or_insert_with(|| serde_json::json!([]));
+        }
+    }
 }
 
 thread_local! {
     static CONTAINED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
-/// Runs a call into the gltf crate, turning a panic into an error. Its validator indexes
-/// arrays with unchecked indices from the file (gltf-json 1.4.1, mesh.rs:151), so a hostile
-/// file can make it panic; while contained, the panic prints nothing.
+/// Runs the gltf crate's validator, turning a panic into an error. It indexes arrays with
+/// unchecked indices from the file (gltf-json 1.4.1, mesh.rs:151), so a hostile file can make
+/// it panic; while contained, the panic prints nothing. Only that call is contained: a panic
+/// in veach's own code is a bug, and the fuzz target and the mutation test must see it.
 fn contained<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     static HOOK: std::sync::Once = std::sync::Once::new();
     HOOK.call_once(|| {
@@ -93,9 +107,9 @@ fn contained<T>(f: impl FnOnce() -> T) -> Result<T, String> {
             }
         }));
     });
-    CONTAINED.with(|c| c.set(true));
+    let outer = CONTAINED.with(|c| c.replace(true));
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
-    CONTAINED.with(|c| c.set(false));
+    CONTAINED.with(|c| c.set(outer));
     result.map_err(|_| "invalid glTF: an index or reference is out of range".to_string())
 }
 
@@ -104,7 +118,7 @@ pub fn describe_file(path: &Path) -> Result<String, Error> {
     let scene = load(path)?;
     let fail = |m: String| Error::Input(format!("{}: {m}", path.display()));
     let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read: {e}")))?;
-    let json = if bytes.starts_with(b"glTF") { glb_json_chunk(&bytes).map_err(fail)? } else { &bytes[..] };
+    let json = if bytes.starts_with(b"glTF") { glb_chunks(&bytes).map_err(fail)?.0 } else { &bytes[..] };
     let raw: serde_json::Value = serde_json::from_slice(json).map_err(|e| fail(format!("invalid glTF JSON: {e}")))?;
     let count = |key: &str| raw.get(key).and_then(|v| v.as_array()).map_or(0, |a| a.len());
     let instances = raw
@@ -147,8 +161,9 @@ pub fn describe_file(path: &Path) -> Result<String, Error> {
     ))
 }
 
-/// The JSON chunk of a GLB, after checking the container's header and chunk bounds.
-fn glb_json_chunk(bytes: &[u8]) -> Result<&[u8], String> {
+/// The JSON chunk of a GLB and its BIN chunk if any, after checking the container's header
+/// and chunk bounds.
+fn glb_chunks(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), String> {
     let word = |at: usize| -> Result<u32, String> {
         bytes
             .get(at..at + 4)
@@ -167,13 +182,18 @@ fn glb_json_chunk(bytes: &[u8]) -> Result<&[u8], String> {
         return Err("GLB's first chunk is not JSON".into());
     }
     let end = 20usize.checked_add(chunk_len).filter(|&e| e <= length).ok_or("GLB JSON chunk runs past the file")?;
-    if end + 8 <= length {
-        let bin_len = word(end)? as usize;
-        if end.checked_add(8).and_then(|s| s.checked_add(bin_len)).is_none_or(|e| e > length) {
-            return Err("GLB BIN chunk runs past the file".into());
+    // Chunks start at multiples of 4 bytes.
+    let bin_at = end.next_multiple_of(4);
+    let mut bin = None;
+    if bin_at + 8 <= length {
+        let (bin_len, bin_type) = (word(bin_at)? as usize, word(bin_at + 4)?);
+        let bin_end = (bin_at + 8).checked_add(bin_len).filter(|&e| e <= length);
+        let bin_end = bin_end.ok_or("GLB BIN chunk runs past the file")?;
+        if bin_type == 0x004E4942 {
+            bin = Some(&bytes[bin_at + 8..bin_end]);
         }
     }
-    Ok(&bytes[20..end])
+    Ok((&bytes[20..end], bin))
 }
 
 /// Required extensions veach cannot honour are an error naming them; used ones it does not
@@ -202,7 +222,7 @@ fn check_extensions(raw: &serde_json::Value, warnings: &mut Vec<String>) -> Resu
 fn from_document(
     doc: &gltf::Document,
     buffers: &[gltf::buffer::Data],
-    base: Option<&Path>,
+    base: resources::Base,
     warnings: &mut Vec<String>,
 ) -> Result<Scene, String> {
     let mut scene = Scene::default();
@@ -441,40 +461,82 @@ pub fn uv_transform(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> [[f32; 
     if m.iter().flatten().all(|v| v.is_finite()) { m } else { TextureRef::IDENTITY }
 }
 
-/// One glTF image as 8-bit RGBA.
-fn decode_image(image: &gltf::Image, base: Option<&Path>, buffers: &[gltf::buffer::Data]) -> Result<Texture, String> {
-    use gltf::image::{Format, Source};
-    // Bounds of an embedded image, checked before the decoder slices the buffer.
-    if let Source::View { view, .. } = image.source() {
-        let len = buffers.get(view.buffer().index()).map_or(0, |b| b.0.len());
-        if view.offset().checked_add(view.length()).is_none_or(|end| end > len) {
-            return Err("its buffer view runs past the buffer".into());
-        }
-    }
-    let data = contained(|| gltf::image::Data::from_source(image.source(), base, buffers))?
+/// One glTF image as 8-bit RGBA, decoded within limits on size and memory.
+fn decode_image(image: &gltf::Image, base: resources::Base, buffers: &[gltf::buffer::Data]) -> Result<Texture, String> {
+    use image::DynamicImage;
+    let encoded = resources::image_bytes(image, buffers, base)?;
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(&encoded[..]))
+        .with_guessed_format()
         .map_err(|e| format!("cannot decode: {e}"))?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_IMAGE_SIDE);
+    limits.max_image_height = Some(MAX_IMAGE_SIDE);
+    limits.max_alloc = Some(MAX_DECODED_IMAGE_BYTES);
+    reader.limits(limits);
+    let decoded = reader.decode().map_err(|e| format!("cannot decode: {e}"))?;
+    let (w, h) = (decoded.width(), decoded.height());
+    if w == 0 || h == 0 || w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE {
+        return Err(format!("{w}×{h} pixels is outside 1..{MAX_IMAGE_SIDE}"));
+    }
+    // 8-bit images as they are; 16-bit by their high byte; float by clamping (the channel
+    // layouts glTF's images come in).
+    let (channels, decoded) = match decoded {
+        DynamicImage::ImageLuma8(_) | DynamicImage::ImageLuma16(_) => (1, decoded),
+        DynamicImage::ImageLumaA8(_) | DynamicImage::ImageLumaA16(_) => (2, decoded),
+        DynamicImage::ImageRgb8(_) | DynamicImage::ImageRgb16(_) | DynamicImage::ImageRgb32F(_) => (3, decoded),
+        other => (4, other),
+    };
+    let (is16, is32) = (
+        matches!(
+            decoded,
+            DynamicImage::ImageLuma16(_)
+                | DynamicImage::ImageLumaA16(_)
+                | DynamicImage::ImageRgb16(_)
+                | DynamicImage::ImageRgba16(_)
+        ),
+        matches!(decoded, DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)),
+    );
+    let decoded = match decoded {
+        d @ (DynamicImage::ImageLuma8(_)
+        | DynamicImage::ImageLumaA8(_)
+        | DynamicImage::ImageRgb8(_)
+        | DynamicImage::ImageRgba8(_)
+        | DynamicImage::ImageLuma16(_)
+        | DynamicImage::ImageLumaA16(_)
+        | DynamicImage::ImageRgb16(_)
+        | DynamicImage::ImageRgba16(_)
+        | DynamicImage::ImageRgb32F(_)
+        | DynamicImage::ImageRgba32F(_)) => d,
+        other => DynamicImage::ImageRgba8(other.to_rgba8()),
+    };
+    let data = DecodedPixels { width: w, height: h, pixels: decoded.into_bytes() };
     let (w, h) = (data.width, data.height);
     if w == 0 || h == 0 || w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE {
         return Err(format!("{w}×{h} pixels is outside 1..{MAX_IMAGE_SIDE}"));
     }
     let px = &data.pixels;
+    let n = (w * h) as usize;
+    let bytes_per_channel = if is32 {
+        4
+    } else if is16 {
+        2
+    } else {
+        1
+    };
+    if px.len() != n * channels * bytes_per_channel {
+        return Err(format!("decoded to {} bytes, not {w}×{h}×{channels} channels", px.len()));
+    }
     let u16_at = |i: usize| (u16::from_ne_bytes([px[2 * i], px[2 * i + 1]]) >> 8) as u8;
     let f32_at = |i: usize| {
         let v = f32::from_ne_bytes([px[4 * i], px[4 * i + 1], px[4 * i + 2], px[4 * i + 3]]);
         (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
     };
-    let n = (w * h) as usize;
-    let (channels, get): (usize, &dyn Fn(usize) -> u8) = match data.format {
-        Format::R8 => (1, &|i| px[i]),
-        Format::R8G8 => (2, &|i| px[i]),
-        Format::R8G8B8 => (3, &|i| px[i]),
-        Format::R8G8B8A8 => (4, &|i| px[i]),
-        Format::R16 => (1, &u16_at),
-        Format::R16G16 => (2, &u16_at),
-        Format::R16G16B16 => (3, &u16_at),
-        Format::R16G16B16A16 => (4, &u16_at),
-        Format::R32G32B32FLOAT => (3, &f32_at),
-        Format::R32G32B32A32FLOAT => (4, &f32_at),
+    let get: &dyn Fn(usize) -> u8 = if is32 {
+        &f32_at
+    } else if is16 {
+        &u16_at
+    } else {
+        &|i| px[i]
     };
     let mut rgba = Vec::with_capacity(4 * n);
     for p in 0..n {
@@ -490,6 +552,16 @@ fn decode_image(image: &gltf::Image, base: Option<&Path>, buffers: &[gltf::buffe
     let name = image.name().map(str::to_string).unwrap_or_else(|| format!("image {}", image.index()));
     Ok(Texture { name, width: w, height: h, rgba })
 }
+
+/// Decoded pixels in the decoder's channel layout.
+struct DecodedPixels {
+    width: u32,
+    height: u32,
+    pixels: Vec<u8>,
+}
+
+/// Largest decoded image held (RGBA32F at the largest side would be 4 GiB).
+const MAX_DECODED_IMAGE_BYTES: u64 = 1 << 30;
 
 /// A KHR_lights_punctual light placed by its node's world transform.
 fn convert_light(light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Option<PunctualLight> {
