@@ -77,8 +77,13 @@ fn intersect_cw_node(node: CwNode, origin: vec3<f32>, inv_dir: vec3<f32>, t_max:
         if (child_meta == 0u) {
             continue;
         }
-        let lo = vec3<f32>((vec3<u32>(node.qx[half], node.qy[half], node.qz[half]) >> vec3<u32>(bits)) & vec3<u32>(0xffu));
-        let hi = vec3<f32>((vec3<u32>(node.qx[2u + half], node.qy[2u + half], node.qz[2u + half]) >> vec3<u32>(bits)) & vec3<u32>(0xffu));
+        let lo = vec3<f32>(
+            (vec3<u32>(node.qx[half], node.qy[half], node.qz[half]) >> vec3<u32>(bits)) & vec3<u32>(0xffu)
+        );
+        let hi = vec3<f32>(
+            (vec3<u32>(node.qx[2u + half], node.qy[2u + half], node.qz[2u + half]) >> vec3<u32>(bits))
+                & vec3<u32>(0xffu)
+        );
         let t0 = lo * scale + shift;
         let t1 = hi * scale + shift;
         let near = min(t0, t1);
@@ -178,7 +183,10 @@ fn trace(ray: Ray, t_max: f32, any_hit: bool) -> Hit {
         if (node.count > 0u) {
             for (var k = node.index; k < node.index + node.count; k++) {
                 let inst = load_instance(k);
-                let local = Ray(transform_point(inst.world_to_object, ray.origin), transform_dir(inst.world_to_object, ray.dir));
+                let local = Ray(
+                    transform_point(inst.world_to_object, ray.origin),
+                    transform_dir(inst.world_to_object, ray.dir)
+                );
                 hit = trace_blas(local, inst.blas_root, hit, any_hit, k);
                 if (any_hit && hit.tri != NO_HIT) {
                     return hit;

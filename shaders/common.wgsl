@@ -1,4 +1,5 @@
-// Shared constants and the packed-scene layouts (twins of src/packed.rs and src/gpu/params.rs).
+// Shared constants and the packed-scene layouts (twins of src/packed/layout.rs, src/accel and
+// src/params.rs; tests/layout.rs checks them).
 
 const PI: f32 = 3.14159265358979;
 const INV_PI: f32 = 0.31830988618379;
@@ -121,8 +122,9 @@ struct LightEntry {
     pmf: f32,
 }
 
-// Render parameters; only sample_index changes from dispatch to dispatch. `cam_right` and `cam_up` are pre-scaled by the image-plane half
-// extents so a camera ray is forward + x·right + y·up.
+// Render parameters; only sample_index changes from dispatch to dispatch. `cam_right` and
+// `cam_up` are pre-scaled by the image-plane half extents so a camera ray is
+// forward + x·right + y·up.
 struct Params {
     cam_position: vec3<f32>,
     film_width: u32,

@@ -35,7 +35,9 @@ fn load_triangle(i: u32) -> Triangle {
     let a = textureLoad(triangle_texels, page_coord(3u * i), 0);
     let b = textureLoad(triangle_texels, page_coord(3u * i + 1u), 0);
     let c = textureLoad(triangle_texels, page_coord(3u * i + 2u), 0);
-    return Triangle(bitcast<vec3<f32>>(a.xyz), a.w, bitcast<vec3<f32>>(b.xyz), bitcast<f32>(b.w), bitcast<vec3<f32>>(c.xyz), c.w);
+    return Triangle(
+        bitcast<vec3<f32>>(a.xyz), a.w, bitcast<vec3<f32>>(b.xyz), bitcast<f32>(b.w), bitcast<vec3<f32>>(c.xyz), c.w
+    );
 }
 
 fn load_attributes(i: u32) -> Attributes {

@@ -24,7 +24,9 @@ fn spawn_point(point: vec3<f32>, ng: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
 // f · |cos θ| · L for a light sample seen from the shading point, or 0 when the sample has no
 // density, the BSDF is zero, the two normals disagree on its side, or something blocks it
 // (tested last: it is the expensive part).
-fn connect(m: Material, frame: Frame, wo: vec3<f32>, eta: f32, point: vec3<f32>, ng: vec3<f32>, ls: LightSample) -> vec3<f32> {
+fn connect(
+    m: Material, frame: Frame, wo: vec3<f32>, eta: f32, point: vec3<f32>, ng: vec3<f32>, ls: LightSample
+) -> vec3<f32> {
     if (ls.pdf <= 0.0) {
         return vec3<f32>(0.0);
     }

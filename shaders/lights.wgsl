@@ -62,6 +62,8 @@ fn light_pdf(tri: Triangle, dist2: f32, cos_light: f32) -> f32 {
 
 const PUNCTUAL_POINT: f32 = 0.0;
 const PUNCTUAL_SPOT: f32 = 1.0;
+// Any other kind is directional (the else branches below).
+const PUNCTUAL_DIRECTIONAL: f32 = 2.0;
 
 fn punctual_light(index: u32) -> Punctual {
     let base = params.punctual_base + 4u * index;

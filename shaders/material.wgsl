@@ -64,7 +64,9 @@ fn oct_decode(bits: u32) -> vec3<f32> {
 // normal map: n' = T·x + B·y + N·z with T Gram-Schmidt'd against N and B = cross(N, T)·w.
 // Attributes are in object space: with instancing they move to world space here (normals by
 // the inverse transpose, tangents by the transform, handedness flipped by mirroring).
-fn shading_normal(tri: Triangle, index: u32, instance: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec2<f32>) -> vec3<f32> {
+fn shading_normal(
+    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec2<f32>
+) -> vec3<f32> {
     var n = ng;
     let a = load_attributes(index);
     var inst: Instance;

@@ -26,7 +26,8 @@ fn srgb_to_linear(c: f32) -> f32 {
 }
 
 fn texel(t: TextureRef, x: i32, y: i32, n: i32) -> vec4<f32> {
-    let c = textureLoad(textures, vec2<i32>(wrap_texel(x, n, t.mode & 3u), wrap_texel(y, n, (t.mode >> 2u) & 3u)), i32(t.layer), 0);
+    let texel = vec2<i32>(wrap_texel(x, n, t.mode & 3u), wrap_texel(y, n, (t.mode >> 2u) & 3u));
+    let c = textureLoad(textures, texel, i32(t.layer), 0);
     if ((t.mode & TEX_SRGB) != 0u) {
         return vec4<f32>(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z), c.w);
     }

@@ -3,17 +3,12 @@
 use veach::gpu::shaders::{Geometry, INTEGRATOR, SOURCES, compose, compose_with};
 
 fn validate(name: &str) -> naga::Module {
-    let src = compose(name).unwrap_or_else(|e| panic!("{name}: {e}"));
-    let module = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{name}:\n{}", e.emit_to_string(&src)));
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
-    module
+    veach::gpu::shaders::check(name, Geometry::Buffers).unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]
 fn every_shader_file_validates_after_includes() {
-    assert!(SOURCES.len() >= 10);
+    // That SOURCES is the shaders/ folder is checked in tests/layout.rs.
     for (name, _) in SOURCES {
         validate(name);
     }
@@ -40,6 +35,27 @@ fn paged_geometry_kernel_validates() {
         .validate(&module)
         .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
     assert!(src.contains("triangle_texels") && !src.contains("array<Triangle>"));
+}
+
+#[test]
+fn shader_errors_name_the_file_and_line() {
+    // The composed source of the integrator, with an error planted on a known line of
+    // mis.wgsl: the message names mis.wgsl and that line, not the composed text.
+    let composed = veach::gpu::shaders::compose_mapped(INTEGRATOR, Geometry::Buffers).unwrap();
+    let at = composed.text.find("fn power_heuristic").expect("power_heuristic in the kernel");
+    let (file, line, column) = composed.locate(at);
+    assert_eq!(file, "mis.wgsl");
+    let expected = veach::gpu::shaders::SOURCES
+        .iter()
+        .find(|(n, _)| *n == "mis.wgsl")
+        .map(|(_, s)| s.lines().position(|l| l.contains("fn power_heuristic")).unwrap() as u32 + 1)
+        .unwrap();
+    assert_eq!((line, column), (expected, 1));
+    let broken = composed.text.replacen("fn power_heuristic", "fn power_heuristic_", 1);
+    let err = naga::front::wgsl::parse_str(&broken).expect_err("a missing function");
+    let span = err.labels().next().map(|(s, _)| s.to_range().unwrap().start).unwrap();
+    let (file, _, _) = composed.locate(span);
+    assert!(file.ends_with(".wgsl") && file != "?", "{file}");
 }
 
 #[test]

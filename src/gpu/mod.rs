@@ -104,6 +104,10 @@ impl GpuContext {
     }
 }
 
+/// Texels per row of the paged-geometry textures, as a power of two (PAGE_ROW_LOG2 in
+/// shaders/geometry_textures.wgsl).
+pub const PAGE_ROW_LOG2: u32 = 12;
+
 /// Samples per submission: enough to amortise the submit, few enough to stay responsive.
 pub const MAX_BATCH: u32 = 64;
 
@@ -170,6 +174,10 @@ impl GpuRenderer {
         let descriptor =
             wgpu::ShaderModuleDescriptor { label: Some("integrator"), source: wgpu::ShaderSource::Wgsl(source.into()) };
         let module = device.create_shader_module(descriptor);
+        if let Err(e) = ctx.check() {
+            // Name the shader file and line rather than the composed source.
+            return Err(shaders::check(shaders::INTEGRATOR, variant).err().map_or(e, Error::Gpu));
+        }
         let storage_entry = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -257,7 +265,7 @@ impl GpuRenderer {
     /// Geometry records paged into rgba32uint textures, 4096 texels a row
     /// (shaders/geometry_textures.wgsl).
     fn geometry_textures(ctx: &GpuContext, data: [&[u8]; 3]) -> Result<[wgpu::TextureView; 3], Error> {
-        const ROW: usize = 4096;
+        const ROW: usize = 1 << PAGE_ROW_LOG2;
         let limits = ctx.device.limits();
         let names = ["BVH nodes", "triangles", "vertex attributes"];
         let mut views = Vec::new();

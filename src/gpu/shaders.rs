@@ -50,17 +50,61 @@ pub fn compose(entry: &str) -> Result<String, String> {
 }
 
 pub fn compose_with(entry: &str, geometry: Geometry) -> Result<String, String> {
-    let mut out = String::new();
+    Ok(compose_mapped(entry, geometry)?.text)
+}
+
+/// A composed source and, for each of its lines, the file and line it came from.
+pub struct Composed {
+    pub text: String,
+    pub origins: Vec<(&'static str, u32)>,
+}
+
+impl Composed {
+    /// The (file, line, column) of a byte offset into `text`.
+    pub fn locate(&self, offset: usize) -> (&'static str, u32, u32) {
+        let before = &self.text[..offset.min(self.text.len())];
+        let line = before.matches('\n').count();
+        let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+        let (file, l) = self.origins.get(line).copied().unwrap_or(("?", 0));
+        (file, l, column as u32)
+    }
+}
+
+pub fn compose_mapped(entry: &str, geometry: Geometry) -> Result<Composed, String> {
+    let mut out = Composed { text: String::new(), origins: Vec::new() };
     let mut included = Vec::new();
     include(entry, geometry, &mut included, &mut out, 0)?;
     Ok(out)
+}
+
+/// Parses and validates a kernel with naga; errors name the shader file and line they are
+/// in, not the composed source.
+pub fn check(entry: &str, geometry: Geometry) -> Result<naga::Module, String> {
+    let composed = compose_mapped(entry, geometry)?;
+    let at = |span: Option<naga::Span>| {
+        span.and_then(|s| s.to_range()).map_or_else(String::new, |r| {
+            let (file, line, column) = composed.locate(r.start);
+            format!("{file}:{line}:{column}: ")
+        })
+    };
+    let module = naga::front::wgsl::parse_str(&composed.text).map_err(|e| {
+        let span = e.labels().next().map(|(span, _)| span);
+        format!("{}{}", at(span), e.message())
+    })?;
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+        .validate(&module)
+        .map_err(|e| {
+            let span = e.spans().next().map(|(span, _)| *span);
+            format!("{}{}", at(span), e.as_inner())
+        })?;
+    Ok(module)
 }
 
 fn include(
     name: &str,
     geometry: Geometry,
     included: &mut Vec<String>,
-    out: &mut String,
+    out: &mut Composed,
     depth: usize,
 ) -> Result<(), String> {
     let name = match (name, geometry) {
@@ -74,16 +118,18 @@ fn include(
     if depth > 32 {
         return Err(format!("{name}: includes nest deeper than 32"));
     }
-    let source =
-        SOURCES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s).ok_or_else(|| format!("no shader named {name}"))?;
+    let (file, source) =
+        SOURCES.iter().find(|(n, _)| *n == name).copied().ok_or_else(|| format!("no shader named {name}"))?;
     included.push(name.to_string());
-    out.push_str(&format!("// ---- {name}\n"));
-    for line in source.lines() {
+    out.text.push_str(&format!("// ---- {name}\n"));
+    out.origins.push((file, 0));
+    for (i, line) in source.lines().enumerate() {
         match line.trim().strip_prefix("#include") {
             Some(rest) => include(rest.trim().trim_matches('"'), geometry, included, out, depth + 1)?,
             None => {
-                out.push_str(line);
-                out.push('\n');
+                out.text.push_str(line);
+                out.text.push('\n');
+                out.origins.push((file, i as u32 + 1));
             }
         }
     }
