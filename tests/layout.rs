@@ -16,7 +16,10 @@ fn module(entry: &str, geometry: Geometry) -> naga::Module {
 }
 
 /// Every named struct of the modules: name → (size, [(member, offset, size)]).
-fn wgsl_structs(modules: &[naga::Module]) -> HashMap<String, (u32, Vec<(String, u32, u32)>)> {
+/// A record's size and its (member, offset, size) list.
+type Layout = (u32, Vec<(String, u32, u32)>);
+
+fn wgsl_structs(modules: &[naga::Module]) -> HashMap<String, Layout> {
     let mut out = HashMap::new();
     for m in modules {
         let mut layouter = naga::proc::Layouter::default();
@@ -74,7 +77,7 @@ const SLOT_RECORDS: &[&str] = &["CwNode", "Instance"];
 fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
     let modules = [module(shaders::INTEGRATOR, Geometry::Buffers), module(shaders::INTEGRATOR, Geometry::Textures)];
     let wgsl = wgsl_structs(&modules);
-    let rust: Vec<(&str, (u32, Vec<(String, u32, u32)>))> = vec![
+    let rust: Vec<(&str, Layout)> = vec![
         (
             "Params",
             rust_layout!(Params {
@@ -169,7 +172,8 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
         // Every Rust field is read by the kernel (trailing slot padding aside).
         for (field, offset, size) in fields {
             let read = covered[*offset as usize..(*offset + *size) as usize].iter().all(|c| *c);
-            if !read && !(field == "pad" && SLOT_RECORDS.contains(name)) {
+            let slot_padding = field == "pad" && SLOT_RECORDS.contains(name);
+            if !read && !slot_padding {
                 wrong.push(format!("{name}.{field}: not covered by the WGSL struct"));
             }
         }
