@@ -220,3 +220,61 @@ fn mutated_assets_never_panic() {
     eprintln!("{inputs} mutated inputs: {loaded} loaded, {refused} refused, {:.1} s", start.elapsed().as_secs_f64());
     assert!(loaded > 100 && refused > 100, "the mutations exercise both outcomes");
 }
+
+/// The triangle's glTF with its buffer moved to `uri` (byteLength kept).
+fn with_buffer_uri(uri: &str) -> Vec<u8> {
+    let ok = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let mut doc: Value = serde_json::from_slice(&triangle_gltf(&ok, &[0, 1, 2], None)).unwrap();
+    doc["buffers"][0]["uri"] = json!(uri);
+    serde_json::to_vec(&doc).unwrap()
+}
+
+#[test]
+fn external_uris_are_read_within_bounds() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = Some(dir.path());
+    // A device, an absolute path and other schemes are never opened.
+    for (uri, needle) in [
+        ("file:///dev/zero", "scheme"),
+        ("/dev/zero", "absolute"),
+        ("https://example.com/a.bin", "scheme"),
+        ("../../../../../../dev/zero", "not a regular file"),
+    ] {
+        let e = veach::scene::gltf::load_bytes(&with_buffer_uri(uri), base).expect_err(uri);
+        assert!(e.contains(needle), "{uri}: {e}");
+    }
+    // Without a base directory, bytes may not name external files at all.
+    let e = veach::scene::gltf::load_bytes(&with_buffer_uri("tri.bin"), None).expect_err("no base");
+    assert!(e.contains("no base directory"), "{e}");
+    // A file larger than its declared byteLength is read only up to it: a huge sparse file
+    // loads as fast as a small one.
+    let doc: Value = serde_json::from_slice(&with_buffer_uri("tri.bin")).unwrap();
+    let bin = {
+        let ok = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+        let mut b: Vec<u8> = ok.iter().flat_map(|f| f.to_le_bytes()).collect();
+        b.extend([0u32, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
+        b
+    };
+    let f = std::fs::File::create(dir.path().join("tri.bin")).unwrap();
+    std::io::Write::write_all(&mut &f, &bin).unwrap();
+    f.set_len(64 << 30).unwrap();
+    let t = std::time::Instant::now();
+    let scene = veach::scene::gltf::load_bytes(&serde_json::to_vec(&doc).unwrap(), base).expect("bounded read");
+    assert_eq!(scene.triangles.len(), 1);
+    assert!(t.elapsed().as_secs() < 10, "read more than the declared bytes");
+    // Shorter than declared is an error naming the buffer.
+    std::fs::write(dir.path().join("tri.bin"), &bin[..10]).unwrap();
+    let e = veach::scene::gltf::load_bytes(&serde_json::to_vec(&doc).unwrap(), base).expect_err("short");
+    assert!(e.contains("buffer 0") && e.contains("fewer"), "{e}");
+    // Percent-encoded names resolve.
+    std::fs::write(dir.path().join("a b.bin"), &bin).unwrap();
+    let doc = with_buffer_uri("a%20b.bin");
+    veach::scene::gltf::load_bytes(&doc, base).expect("percent-encoded URI");
+}
+
+#[test]
+fn a_scene_without_nodes_is_empty_not_invalid() {
+    let doc = json!({"asset": {"version": "2.0"}, "scenes": [{"name": "empty"}], "scene": 0});
+    let scene = load_bytes(&serde_json::to_vec(&doc).unwrap(), None).expect("valid glTF");
+    assert!(scene.triangles.is_empty());
+}

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod build;
+pub mod cli;
 
 use glam::Vec3;
 use std::path::{Path, PathBuf};

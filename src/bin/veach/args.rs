@@ -176,13 +176,13 @@ pub struct LookArgs {
     #[arg(long)]
     pub env: Option<PathBuf>,
     /// Scales the environment (map or color).
-    #[arg(long, default_value_t = 1.0, value_parser = parse_non_negative)]
+    #[arg(long, default_value_t = 1.0, value_parser = parse_non_negative, allow_negative_numbers = true)]
     pub env_strength: f32,
     /// Thin-lens radius in scene units for depth of field (default: a pinhole).
-    #[arg(long, default_value_t = 0.0, value_parser = parse_non_negative)]
+    #[arg(long, default_value_t = 0.0, value_parser = parse_non_negative, allow_negative_numbers = true)]
     pub aperture: f32,
     /// Distance in focus (default with --aperture: what the image centre sees).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub focus_distance: Option<f32>,
 }
 
@@ -238,7 +238,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub checkpoint: Option<PathBuf>,
     /// Seconds between checkpoints.
-    #[arg(long, default_value_t = 60.0, value_parser = parse_seconds)]
+    #[arg(long, default_value_t = 60.0, value_parser = parse_seconds, allow_negative_numbers = true)]
     pub checkpoint_every: f64,
     /// Continue the render saved in this checkpoint (or any EXR veach wrote) to its target.
     #[arg(long)]
