@@ -5,17 +5,21 @@
 //! [`Film`] → PNG/EXR ([`output`]) or a window. The command line and the viewer are thin
 //! shells over this API.
 //!
-//! ```no_run
+//! ```
 //! # fn main() -> Result<(), veach::Error> {
 //! let loaded = veach::load("assets/cornell-box.gltf".as_ref(), None)?;
-//! let settings = veach::Settings { width: 128, height: 128, ..Default::default() };
+//! let settings = veach::Settings { width: 32, height: 32, ..Default::default() };
 //! let packed = veach::PackedScene::new(&loaded.scene);
 //! let mut renderer = veach::Renderer::new(packed, &loaded.camera, &settings, veach::Backend::Cpu)?;
-//! renderer.render_samples(0, 16)?;
+//! renderer.render_samples(0, 4)?;
 //! let film = renderer.film()?;
-//! veach::output::write(&film, "cornell.png".as_ref(), 0.0, None)?;
+//! assert_eq!(film.samples(), 4);
+//! veach::output::write(&film, &std::env::temp_dir().join("veach-doc.png"), 0.0, None)?;
 //! # Ok(()) }
 //! ```
+//!
+//! `examples/embed.rs` shows the rest: loading from bytes, time budgets with progress and
+//! cancellation, film access, checkpoints, resume, merge and a swapped environment.
 
 #[doc(hidden)]
 pub mod accel;

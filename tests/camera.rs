@@ -49,6 +49,7 @@ fn aperture_alone_focuses_on_what_the_centre_sees() {
 }
 
 #[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn gpu_and_cpu_agree_with_a_lens() {
     let Some(ctx) = gpu("gpu_and_cpu_agree_with_a_lens") else { return };
     let mut s = settings(48, 8, 31);

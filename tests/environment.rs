@@ -123,6 +123,7 @@ fn constant_map_is_a_constant_environment() {
 }
 
 #[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn gpu_and_cpu_agree_under_a_sky() {
     let Some(ctx) = gpu("gpu_and_cpu_agree_under_a_sky") else { return };
     let g = furnace_with_map(sky(64, 32), Some(ctx), 3);

@@ -129,6 +129,7 @@ fn veach_scene_matches_reference() {
 }
 
 #[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn gpu_and_cpu_agree_on_veach_and_furnace() {
     // The Veach image mean is heavy-tailed at 128 spp: one sample that reaches the smallest
     // light (radiance 900) through a sharp plate moves it by 0.4 %, and seeds differ by up to

@@ -110,6 +110,7 @@ const GPU_FILMS: &[(&str, &[u64])] = &[(
 )];
 
 #[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn gpu_films_of_bundled_scenes_are_unchanged() {
     let Some(ctx) = common::gpu("gpu_films_of_bundled_scenes_are_unchanged") else { return };
     let driver = format!("{} {}", ctx.info.driver, ctx.info.driver_info);

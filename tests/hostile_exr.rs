@@ -80,7 +80,7 @@ fn find_header_end(bytes: &[u8], from: usize) -> Option<usize> {
 #[test]
 fn damaged_metadata_is_refused_with_one_line() {
     let d = temp_dir("hostile-exr");
-    let base = std::fs::read(part(&d.path(), "base.exr", &["--spp", "2"])).unwrap();
+    let base = std::fs::read(part(d.path(), "base.exr", &["--spp", "2"])).unwrap();
     let (_, _, job) = metadata(&base);
     // Sanity: the unmodified rewrite still merges.
     let same = d.path().join("same.exr");
@@ -113,7 +113,7 @@ fn damaged_metadata_is_refused_with_one_line() {
 #[test]
 fn parts_of_other_renders_are_refused() {
     let d = temp_dir("hostile-merge");
-    let a = part(&d.path(), "a.exr", &["--sample-range", "0..2"]);
+    let a = part(d.path(), "a.exr", &["--sample-range", "0..2"]);
     let out = d.path().join("out.exr");
     for (flags, needle) in [
         (&["--env-color", "0.5,0.5,0.5"][..], "environment color"),
@@ -126,11 +126,11 @@ fn parts_of_other_renders_are_refused() {
     ] {
         let mut f = vec!["--sample-range", "2..4"];
         f.extend_from_slice(flags);
-        let b = part(&d.path(), "b.exr", &f);
+        let b = part(d.path(), "b.exr", &f);
         assert_user_error(&veach(&["merge", s(&a), s(&b), "-o", s(&out)], &[]), needle);
     }
     // Overlapping samples in the same pixels are refused too.
-    let c = part(&d.path(), "c.exr", &["--sample-range", "1..3"]);
+    let c = part(d.path(), "c.exr", &["--sample-range", "1..3"]);
     assert_user_error(&veach(&["merge", s(&a), s(&c), "-o", s(&out)], &[]), "overlap");
 }
 
@@ -167,8 +167,10 @@ fn hostile_flags_exit_2() {
         }
         assert_user_error(&o, needle);
     }
-    let saved = part(&d.path(), "saved.exr", &["--spp", "2"]);
-    for flags in [&["--spp", "8"][..], &["--width", "32"], &["--env-color", "1,1,1"], &["--tile", "0,0,4,4"], &["--seed", "2"]] {
+    let saved = part(d.path(), "saved.exr", &["--spp", "2"]);
+    for flags in
+        [&["--spp", "8"][..], &["--width", "32"], &["--env-color", "1,1,1"], &["--tile", "0,0,4,4"], &["--seed", "2"]]
+    {
         let mut args = vec!["render", "--resume", s(&saved), "-o", s(&out)];
         args.extend_from_slice(flags);
         let o = veach(&args, &[]);
@@ -189,8 +191,24 @@ impl Lcg {
 
 /// Numbers a mutation puts into the metadata: edges of every integer and float range.
 const EXTREMES: &[f64] = &[
-    0.0, -0.0, 1.0, -1.0, 15.0, 16.0, 17.0, 255.0, 65536.0, 2147483647.0, 2147483648.0, 4294967295.0, 4294967296.0,
-    1e30, -1e30, 1e-45, 0.5, 3.0,
+    0.0,
+    -0.0,
+    1.0,
+    -1.0,
+    15.0,
+    16.0,
+    17.0,
+    255.0,
+    65536.0,
+    2147483647.0,
+    2147483648.0,
+    4294967295.0,
+    4294967296.0,
+    1e30,
+    -1e30,
+    1e-45,
+    0.5,
+    3.0,
 ];
 
 fn numeric_paths(v: &Value, path: String, out: &mut Vec<String>) {
@@ -205,8 +223,7 @@ fn numeric_paths(v: &Value, path: String, out: &mut Vec<String>) {
 #[test]
 fn mutated_parts_never_panic() {
     let d = temp_dir("mutated-exr");
-    let base = std::fs::read(part(&d.path(), "base.exr", &["--spp", "2", "--tile", "0,0,16,8"]))
-        .unwrap();
+    let base = std::fs::read(part(d.path(), "base.exr", &["--spp", "2", "--tile", "0,0,16,8"])).unwrap();
     let (_, _, job) = metadata(&base);
     let mut paths = Vec::new();
     numeric_paths(&job, String::new(), &mut paths);
@@ -266,8 +283,7 @@ fn mutated_parts_never_panic() {
             let part = veach::Part { film: film.clone(), job: job.clone(), path: file.clone() };
             veach::merge(std::slice::from_ref(&part))?;
             // Resume: the saved settings over the scene, the film set into the renderer.
-            let mut r =
-                veach::Renderer::new(packed.clone(), &loaded.camera, &job.settings, veach::Backend::Cpu)?;
+            let mut r = veach::Renderer::new(packed.clone(), &loaded.camera, &job.settings, veach::Backend::Cpu)?;
             r.set_film(&film)?;
             Ok::<(), veach::Error>(())
         });

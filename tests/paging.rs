@@ -17,6 +17,7 @@ fn render(path: &std::path::Path, ctx: veach::gpu::GpuContext) -> veach::film::F
 }
 
 #[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn geometry_in_textures_renders_the_same_film_as_in_buffers() {
     let Some(ctx) = common::gpu("geometry_in_textures_renders_the_same_film_as_in_buffers") else { return };
     for scene in ["veach-mis.gltf", "cornell-glass.gltf"] {

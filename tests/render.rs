@@ -35,6 +35,7 @@ fn cornell_box_matches_reference_cpu() {
 }
 
 #[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn cornell_box_matches_reference_gpu() {
     if let Some(ctx) = gpu("cornell_box_matches_reference_gpu") {
         cornell_box_against_reference(Some(ctx), "cbox gpu");
@@ -79,6 +80,7 @@ fn detects_bias() {
 }
 
 #[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn gpu_and_cpu_agree_in_distribution() {
     // Different seeds: two independent estimates of the same image.
     let Some(ctx) = gpu("gpu_and_cpu_agree_in_distribution") else { return };
@@ -90,6 +92,7 @@ fn gpu_and_cpu_agree_in_distribution() {
 }
 
 #[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn gpu_and_cpu_trace_the_same_paths() {
     // Same seed: both backends draw the same random numbers, so apart from float rounding
     // (which can flip a rare path) they compute the same pixels.
@@ -127,6 +130,7 @@ fn white_furnace_cpu() {
 }
 
 #[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn white_furnace_gpu() {
     if let Some(ctx) = gpu("white_furnace_gpu") {
         furnace(Some(ctx), "white furnace gpu");
@@ -167,6 +171,7 @@ fn same_seed_same_bytes_cpu() {
 }
 
 #[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn same_seed_same_bytes_gpu() {
     let Some(a) = gpu("same_seed_same_bytes_gpu") else { return };
     let first = film_bytes(Some(a), 11);

@@ -7,6 +7,7 @@ use std::process::Command;
 mod common;
 
 #[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn viewer_screenshot_shows_the_render_and_the_panel() {
     let has_xvfb = Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
     let required = std::env::var("VEACH_REQUIRE_GPU").as_deref() == Ok("1");

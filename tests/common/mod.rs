@@ -27,7 +27,7 @@ pub fn gpu(test: &str) -> Option<GpuContext> {
             if std::env::var("VEACH_REQUIRE_GPU").as_deref() == Ok("1") {
                 panic!("{test}: VEACH_REQUIRE_GPU=1 but the GPU is unavailable: {e}");
             }
-            eprintln!("skipping the GPU part of {test}: {e}");
+            eprintln!("SKIPPED the GPU part of {test}: {e}");
             None
         }
     }
