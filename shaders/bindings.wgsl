@@ -16,6 +16,6 @@
 // Light data: environment map texels (rgb, row CDF), the marginal CDF of the rows (x), then
 // the punctual lights (four rows each, from params.punctual_base). One buffer for both keeps
 // the kernel within WebGPU's default of 8 storage buffers.
-@group(0) @binding(7) var<storage, read> env_texels: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> light_data: array<vec4<f32>>;
 // Every image of the scene, one square RGBA8 layer each (no binding arrays on lavapipe).
 @group(0) @binding(8) var textures: texture_2d_array<f32>;

@@ -30,7 +30,7 @@ fn environment_radiance(dir: vec3<f32>) -> vec3<f32> {
     if (params.env_width == 0u) {
         return params.environment;
     }
-    return env_texels[env_texel_index(env_uv(dir))].xyz * params.environment;
+    return light_data[env_texel_index(env_uv(dir))].xyz * params.environment;
 }
 
 // Solid-angle density with which light sampling produces direction `dir` from the environment.
@@ -43,7 +43,7 @@ fn environment_pdf(dir: vec3<f32>) -> f32 {
     let index = env_texel_index(env_uv(dir));
     let i = index / w;
     let sin_centre = sin(PI * (f32(i) + 0.5) / f32(h));
-    let func = luminance(env_texels[index].xyz) * sin_centre;
+    let func = luminance(light_data[index].xyz) * sin_centre;
     let sin_dir = length(dir.xz);
     if (sin_dir <= 0.0 || params.env_total <= 0.0) {
         return 0.0;
@@ -52,23 +52,23 @@ fn environment_pdf(dir: vec3<f32>) -> f32 {
     return params.env_select * pdf_uv / (2.0 * PI * PI * sin_dir);
 }
 
-// Inverts a piecewise-constant CDF stored in env_texels[base .. base + n] (the marginal CDF in
+// Inverts a piecewise-constant CDF stored in light_data[base .. base + n] (the marginal CDF in
 // .x, a row's conditional CDF in .w): the first entry above u, and u's place inside it.
 fn env_sample_cdf(base: u32, n: u32, u: f32, marginal: bool) -> vec2<f32> {
     var lo = 0u;
     var hi = n - 1u;
     while (lo < hi) {
         let mid = (lo + hi) / 2u;
-        let t = env_texels[base + mid];
+        let t = light_data[base + mid];
         if (select(t.w, t.x, marginal) > u) {
             hi = mid;
         } else {
             lo = mid + 1u;
         }
     }
-    let before = env_texels[base + max(lo, 1u) - 1u];
+    let before = light_data[base + max(lo, 1u) - 1u];
     let c0 = select(0.0, select(before.w, before.x, marginal), lo > 0u);
-    let t = env_texels[base + lo];
+    let t = light_data[base + lo];
     let c1 = select(t.w, t.x, marginal);
     return vec2<f32>(f32(lo), clamp((u - c0) / max(c1 - c0, 1e-30), 0.0, 0.99999));
 }

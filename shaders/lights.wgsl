@@ -67,10 +67,10 @@ const PUNCTUAL_DIRECTIONAL: f32 = 2.0;
 
 fn punctual_light(index: u32) -> Punctual {
     let base = params.punctual_base + 4u * index;
-    let r0 = env_texels[base];
-    let r1 = env_texels[base + 1u];
-    let r2 = env_texels[base + 2u];
-    let r3 = env_texels[base + 3u];
+    let r0 = light_data[base];
+    let r1 = light_data[base + 1u];
+    let r2 = light_data[base + 2u];
+    let r3 = light_data[base + 3u];
     return Punctual(r0.xyz, r0.w, r1.xyz, r1.w, r2.xyz, r2.w, r3.x, 0.0, 0.0, 0.0);
 }
 

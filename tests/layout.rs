@@ -296,3 +296,22 @@ fn the_shader_list_is_the_shaders_folder() {
         }
     }
 }
+
+#[test]
+fn the_host_binding_table_is_the_kernel_s() {
+    for geometry in [Geometry::Buffers, Geometry::Textures] {
+        let m = module(shaders::INTEGRATOR, geometry);
+        let mut kernel: Vec<(u32, String)> = m
+            .global_variables
+            .iter()
+            .filter_map(|(_, g)| Some((g.binding.as_ref()?.binding, g.name.clone().unwrap_or_default())))
+            .collect();
+        kernel.sort();
+        let host: Vec<u32> = veach::gpu::BINDINGS.iter().map(|b| b.0).collect();
+        assert_eq!(kernel.iter().map(|k| k.0).collect::<Vec<_>>(), host, "{geometry:?}: binding numbers");
+        if geometry == Geometry::Buffers {
+            let names: Vec<&str> = veach::gpu::BINDINGS.iter().map(|b| b.2).collect();
+            assert_eq!(kernel.iter().map(|k| k.1.as_str()).collect::<Vec<_>>(), names, "binding names");
+        }
+    }
+}

@@ -1,7 +1,7 @@
 //! Scenes beyond a storage binding (128 MiB on lavapipe, ~2.8 M triangles) read their geometry
 //! from textures instead (shaders/geometry_textures.wgsl). The paged kernel must trace exactly
-//! the paths the buffer kernel traces: same film, bit for bit. VEACH_GEOMETRY=textures forces
-//! paging for a small scene; this file holds one test so the variable affects nothing else.
+//! the paths the buffer kernel traces: same film, bit for bit. `GeometryPlacement::Textures`
+//! forces paging for a small scene.
 
 mod common;
 
@@ -23,10 +23,9 @@ fn geometry_in_textures_renders_the_same_film_as_in_buffers() {
     for scene in ["veach-mis.gltf", "cornell-glass.gltf"] {
         let path = common::asset(scene);
         let buffers = render(&path, ctx.clone());
-        // SAFETY: this test binary runs this one test; nothing else reads the environment now.
-        unsafe { std::env::set_var("VEACH_GEOMETRY", "textures") };
-        let textures = render(&path, ctx.clone());
-        unsafe { std::env::remove_var("VEACH_GEOMETRY") };
+        let mut paged = ctx.clone();
+        paged.options.geometry = veach::gpu::GeometryPlacement::Textures;
+        let textures = render(&path, paged);
         assert_eq!(buffers.samples(), textures.samples());
         for i in 0..buffers.pixel_count() {
             assert_eq!(buffers.sum(i), textures.sum(i), "{scene}: pixel {i} differs");

@@ -135,3 +135,17 @@ fn include(
     }
     Ok(())
 }
+
+/// The kernel `entry` as a shader module on `ctx`'s device; a compile error names the shader
+/// file and line.
+pub fn module(ctx: &super::GpuContext, entry: &str, geometry: Geometry) -> Result<wgpu::ShaderModule, crate::Error> {
+    let source = compose_with(entry, geometry).map_err(crate::Error::Gpu)?;
+    let module = ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(entry),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    if let Err(e) = ctx.check() {
+        return Err(check(entry, geometry).err().map_or(e, crate::Error::Gpu));
+    }
+    Ok(module)
+}
