@@ -278,3 +278,64 @@ fn a_scene_without_nodes_is_empty_not_invalid() {
     let scene = load_bytes(&serde_json::to_vec(&doc).unwrap(), None).expect("valid glTF");
     assert!(scene.triangles.is_empty());
 }
+
+/// Degenerate vertex data users' files carry: zero-length and opposite normals, identical or
+/// collinear UVs under a normal map without tangents (generated tangents degenerate), a
+/// sliver triangle, a light seen edge-on. Both engines must take 0 non-finite samples:
+/// dropping them would hide a bias.
+#[test]
+fn degenerate_vertex_data_gives_no_non_finite_samples() {
+    use common::build::{GltfBuilder, MeshData};
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = GltfBuilder::new(dir.path(), "degenerate");
+    let bumps = image::RgbaImage::from_fn(8, 8, |x, y| image::Rgba([(x * 32) as u8, (y * 32) as u8, 200, 255]));
+    let normal_map = b.texture(&bumps, 10497);
+    let mat = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0.5,
+        "roughnessFactor": 0.3}, "normalTexture": {"index": normal_map, "scale": 4.0}, "doubleSided": true}));
+    let lamp = b.material(json!({"emissiveFactor": [5, 5, 5]}));
+    let mesh = MeshData {
+        positions: vec![
+            [-1.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 1e-7],
+            [4.0, 0.0, 0.0],
+            [0.5, 0.5, 0.2],
+        ],
+        normals: vec![
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, -1.0],
+            [0.0, 0.0, 1.0],
+            [1e-30, 0.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, -1.0],
+        ],
+        uvs: vec![[0.5, 0.5], [0.5, 0.5], [0.5, 0.5], [0.0, 1.0], [0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [0.5, 0.5]],
+        tangents: Vec::new(),
+        indices: vec![0, 1, 2, 0, 2, 3, 4, 5, 6, 0, 7, 2, 3, 7, 1],
+    };
+    let m = b.mesh(&mesh, mat);
+    b.node(json!({"mesh": m}));
+    let light = b.mesh(&MeshData::quad(-0.5, -0.5, 0.5, 0.5, 0.0, MeshData::UPRIGHT), lamp);
+    // Edge-on to the scene's plane, and one facing it.
+    b.node(json!({"mesh": light, "translation": [0.0, 0.0, 2.0], "rotation": [0.7071068, 0.0, 0.0, 0.7071068]}));
+    b.node(json!({"mesh": light, "translation": [0.0, 0.0, 3.0], "rotation": [1.0, 0.0, 0.0, 0.0]}));
+    b.camera(1.0, 1.0, [0.3, 0.2, 4.0]);
+    let path = b.write();
+    let (scene, camera) = common::load_pair(&path, None).expect("loads");
+    let packed = veach::PackedScene::new(&scene);
+    let settings =
+        veach::Settings { width: 48, height: 48, max_depth: 6, env_color: Some([0.3; 3]), ..Default::default() };
+    for ctx in [None, common::gpu("degenerate_vertex_data_gives_no_non_finite_samples")] {
+        let gpu = ctx.is_some();
+        let mut r = common::renderer(packed.clone(), &camera, &settings, ctx).unwrap();
+        r.render_samples(0, 32).unwrap();
+        let film = r.film().unwrap();
+        assert_eq!(film.nonfinite_samples(), 0, "gpu {gpu}: non-finite samples");
+        assert!(film.samples() == 32 && film.mean(24 * 48 + 24).max_element() > 0.0, "gpu {gpu}: an empty image");
+    }
+}

@@ -4,6 +4,7 @@
 
 mod bindings;
 mod context;
+mod display;
 mod film;
 mod geometry;
 mod renderer;
@@ -14,6 +15,7 @@ mod trace;
 
 pub use bindings::TABLE as BINDINGS;
 pub use context::{GeometryPlacement, GpuContext, GpuOptions, NO_ADAPTER_HINT, adapters};
+pub use display::Display;
 pub use renderer::{GpuRenderer, WORKGROUP_SIDE};
 
 use crate::Error;

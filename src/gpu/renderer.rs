@@ -16,8 +16,11 @@ pub struct GpuRenderer {
     pub(super) ctx: GpuContext,
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    #[cfg(feature = "bench")]
     pub(super) pipeline_layout: wgpu::PipelineLayout,
+    #[cfg(feature = "bench")]
     pub(super) variant: shaders::Geometry,
+    #[cfg(feature = "bench")]
     pub(super) constants: [(&'static str, f64); 5],
     /// `trace_rays` pipelines by TRACE_KIND, built on first use (by `veach bench` only).
     #[cfg(feature = "bench")]
@@ -101,8 +104,11 @@ impl GpuRenderer {
             ctx,
             pipeline,
             layout,
+            #[cfg(feature = "bench")]
             pipeline_layout,
+            #[cfg(feature = "bench")]
             variant,
+            #[cfg(feature = "bench")]
             constants,
             #[cfg(feature = "bench")]
             trace_pipelines: [None, None, None],
