@@ -72,3 +72,15 @@ fn gpu_and_cpu_agree_with_a_lens() {
     let d = agreement(&bm, &bv, &pm, &pv);
     assert!(d.outliers > 0.02, "depth of field is visible: {d:?}");
 }
+
+#[test]
+fn the_first_camera_is_the_file_s_first_even_unnamed() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = common::build::GltfBuilder::new(dir.path(), "two-cameras");
+    b.camera(0.8, 1.0, [1.0, 0.0, 5.0]);
+    b.camera(0.8, 1.0, [-1.0, 0.0, 5.0]);
+    let (scene, camera) = common::load_pair(&b.write(), None).unwrap();
+    assert_eq!(camera.position, Vec3::new(1.0, 0.0, 5.0), "{:?}", scene.cameras);
+    let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, ["camera0", "camera1"]);
+}

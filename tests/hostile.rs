@@ -286,6 +286,7 @@ fn a_scene_without_nodes_is_empty_not_invalid() {
 #[test]
 fn degenerate_vertex_data_gives_no_non_finite_samples() {
     use common::build::{GltfBuilder, MeshData};
+    use std::f32::consts::FRAC_1_SQRT_2;
     let dir = tempfile::tempdir().unwrap();
     let mut b = GltfBuilder::new(dir.path(), "degenerate");
     let bumps = image::RgbaImage::from_fn(8, 8, |x, y| image::Rgba([(x * 32) as u8, (y * 32) as u8, 200, 255]));
@@ -322,7 +323,9 @@ fn degenerate_vertex_data_gives_no_non_finite_samples() {
     b.node(json!({"mesh": m}));
     let light = b.mesh(&MeshData::quad(-0.5, -0.5, 0.5, 0.5, 0.0, MeshData::UPRIGHT), lamp);
     // Edge-on to the scene's plane, and one facing it.
-    b.node(json!({"mesh": light, "translation": [0.0, 0.0, 2.0], "rotation": [0.7071068, 0.0, 0.0, 0.7071068]}));
+    b.node(
+        json!({"mesh": light, "translation": [0.0, 0.0, 2.0], "rotation": [FRAC_1_SQRT_2, 0.0, 0.0, FRAC_1_SQRT_2]}),
+    );
     b.node(json!({"mesh": light, "translation": [0.0, 0.0, 3.0], "rotation": [1.0, 0.0, 0.0, 0.0]}));
     b.camera(1.0, 1.0, [0.3, 0.2, 4.0]);
     let path = b.write();
