@@ -4,9 +4,12 @@ use super::bvh::INF;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
+/// D(h) = α² / (π (cos²θ (α² − 1) + 1)²), with the denominator written as α² cos²θ + sin²θ:
+/// the textbook form cancels to 0 when α² is below f32's epsilon (roughness < 0.016), making
+/// D infinite and the sample NaN.
 pub fn ggx_d(h: Vec3, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
-    let d = h.z * h.z * (a2 - 1.0) + 1.0;
+    let d = a2 * h.z * h.z + (h.x * h.x + h.y * h.y);
     a2 / (PI * d * d)
 }
 
