@@ -2,10 +2,9 @@
 //! load and BVH-build times, device memory per triangle, and the BVH's traversal throughput
 //! for primary, shadow and diffuse-bounce rays. Timing only: nothing here asserts.
 
-use crate::cpu::bvh::{Ray, intersect_closest, occluded, offset_ray};
+use crate::cpu::bvh::{Ray, intersect_closest, offset_ray};
 use crate::cpu::frame::{frame_from_normal, from_local};
-use crate::cpu::rng::{rng_init, rng_next2};
-use crate::cpu::sampling::{sample_cosine_hemisphere, sample_uniform_triangle};
+use crate::cpu::sampling::sample_cosine_hemisphere;
 use crate::packed::PackedScene;
 use crate::{Backend, Error, Renderer, Settings, gpu};
 use glam::Vec3;
@@ -67,10 +66,6 @@ pub struct SceneResult {
     pub rays: Vec<RayResult>,
     /// Traversal in the GPU kernel (`shaders/trace.wgsl`), when the GPU backend was run.
     pub gpu_rays: Vec<RayResult>,
-    /// The same rays on the CPU through obvhs's compressed 8-wide BVH (Ylitie et al. 2017)
-    /// and its own (SIMD) traversal, for comparison with our walk (scenes without instances).
-    pub cwbvh_rays: Vec<RayResult>,
-    pub cwbvh_build_seconds: f64,
 }
 
 #[derive(Clone, Debug, serde::Serialize)]
@@ -113,8 +108,6 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
             renders: Vec::new(),
             rays: Vec::new(),
             gpu_rays: Vec::new(),
-            cwbvh_rays: Vec::new(),
-            cwbvh_build_seconds: 0.0,
         };
         let settings =
             Settings { width: opts.width, height: opts.height, max_depth: opts.max_depth, ..Settings::default() };
@@ -140,14 +133,7 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
         }
         progress(&format!("{name}: tracing ray batches"));
         let r = Renderer::new(packed, &camera, &settings, Backend::Cpu)?;
-        let (rays, batches) = ray_throughput(r.scene(), r.params());
-        result.rays = rays;
-        if r.scene().instance_count == 0 {
-            match cwbvh_ray_throughput(r.scene(), &batches) {
-                Ok((rays, seconds)) => (result.cwbvh_rays, result.cwbvh_build_seconds) = (rays, seconds),
-                Err(why) => progress(&format!("{name}: CWBVH comparison left out: {why}")),
-            }
-        }
+        result.rays = ray_throughput(r.scene(), r.params());
         if let Some(ctx) = &ctx {
             let mut g = gpu::GpuRenderer::new(ctx.clone(), r.scene(), *r.params())?;
             result.gpu_rays = gpu_ray_throughput(&mut g)?;
@@ -162,64 +148,66 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
     })
 }
 
-/// Primary rays through every pixel; shadow rays from their hits to a point on a light
-/// (or straight up when the scene has none); cosine-distributed bounce rays from the hits.
-fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> (Vec<RayResult>, [Vec<Ray>; 3]) {
+/// The rays `shaders/trace.wgsl` traces, on the CPU reference's walk: a primary ray per
+/// pixel (sample 0 of the render's sampler), then from each hit a shadow ray to a light sample
+/// (`sample_light`, `unoccluded`, as the integrator connects) and a cosine-distributed bounce
+/// ray, each drawn from the sampler right after the camera ray, as each trace kernel does.
+fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<RayResult> {
+    use crate::cpu::integrator::unoccluded;
+    use crate::cpu::sampler::{sample_1d, sample_2d};
     let (w, h) = (params.image_width, params.image_height);
-    let first = crate::params::Params { sample_index: 0, seed: 1, ..*params };
-    let primary: Vec<Ray> =
-        (0..w * h).map(|i| crate::cpu::camera::camera_sample(&first, glam::UVec2::new(i % w, i / w)).0).collect();
-    let hits: Vec<_> = primary.par_iter().map(|r| intersect_closest(scene, r)).collect();
+    let first = crate::params::Params { sample_index: 0, ..*params };
+    let primary: Vec<_> =
+        (0..w * h).map(|i| crate::cpu::camera::camera_sample(&first, glam::UVec2::new(i % w, i / w))).collect();
+    let hits: Vec<_> = primary.par_iter().map(|(r, _)| intersect_closest(scene, r)).collect();
     let primary_result = RayResult::new(
         "primary",
         primary.len(),
         best_of(|| {
-            std::hint::black_box(primary.par_iter().map(|r| intersect_closest(scene, r).t).sum::<f32>());
+            std::hint::black_box(primary.par_iter().map(|(r, _)| intersect_closest(scene, r).t).sum::<f32>());
         }),
     );
-    // Surface points and their normals, facing the camera.
-    let surface: Vec<(Vec3, Vec3)> = primary
+    // Surface points and their normals facing the camera, and each path's sampler.
+    let surface: Vec<_> = primary
         .iter()
         .zip(&hits)
         .filter(|(_, hit)| hit.tri != crate::cpu::bvh::NO_HIT)
-        .map(|(ray, hit)| {
+        .map(|((ray, sampler), hit)| {
             let tri = crate::cpu::instance::world_triangle(scene, hit.tri, hit.instance);
             let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
             let n = e1.cross(e2).normalize();
-            let n = if n.dot(ray.dir) > 0.0 { -n } else { n };
-            let p = Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2;
-            (offset_ray(p, n), n)
+            let ng = if n.dot(ray.dir) > 0.0 { -n } else { n };
+            (Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2, ng, sampler.clone())
         })
         .collect();
-    let light = scene.lights.first().map(|l| scene.triangles[l.triangle as usize]);
-    let shadow: Vec<Ray> = surface
-        .iter()
-        .enumerate()
-        .map(|(i, &(p, n))| {
-            let mut rng = rng_init(i as u32, 1, 1);
-            match light {
-                Some(tri) => {
-                    let b = sample_uniform_triangle(rng_next2(&mut rng));
-                    let q = Vec3::from(tri.p0) + b.x * Vec3::from(tri.e1) + b.y * Vec3::from(tri.e2);
-                    Ray { origin: p, dir: q - p }
-                }
-                None => Ray { origin: p, dir: n },
-            }
-        })
-        .collect();
+    let lit = params.light_count > 0 || params.env_select > 0.0;
+    let shadow: Vec<_> = if lit {
+        surface
+            .iter()
+            .map(|(p, ng, sampler)| {
+                let mut sampler = sampler.clone();
+                let u0 = sample_1d(&mut sampler);
+                let u12 = sample_2d(&mut sampler);
+                (offset_ray(*p, *ng), crate::cpu::lights::sample_light(scene, params, *p, Vec3::new(u0, u12.x, u12.y)))
+            })
+            .filter(|(_, ls)| ls.pdf > 0.0)
+            .collect()
+    } else {
+        Vec::new()
+    };
     let shadow_result = RayResult::new(
         "shadow",
         shadow.len(),
         best_of(|| {
-            std::hint::black_box(shadow.par_iter().filter(|r| occluded(scene, r, 0.999)).count());
+            std::hint::black_box(shadow.par_iter().filter(|(o, ls)| unoccluded(scene, *o, ls)).count());
         }),
     );
     let diffuse: Vec<Ray> = surface
         .iter()
-        .enumerate()
-        .map(|(i, &(p, n))| {
-            let mut rng = rng_init(i as u32, 2, 1);
-            Ray { origin: p, dir: from_local(&frame_from_normal(n), sample_cosine_hemisphere(rng_next2(&mut rng))) }
+        .map(|(p, ng, sampler)| {
+            let mut sampler = sampler.clone();
+            let wi = from_local(&frame_from_normal(*ng), sample_cosine_hemisphere(sample_2d(&mut sampler)));
+            Ray { origin: offset_ray(*p, *ng), dir: wi }
         })
         .collect();
     let diffuse_result = RayResult::new(
@@ -229,90 +217,7 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> (Vec<R
             std::hint::black_box(diffuse.par_iter().map(|r| intersect_closest(scene, r).t).sum::<f32>());
         }),
     );
-    (vec![primary_result, shadow_result, diffuse_result], [primary, shadow, diffuse])
-}
-
-/// The batches of `ray_throughput` through a CWBVH that obvhs builds from the packed triangles
-/// (same build settings as ours) and walks with its own SIMD traversal, with our triangle
-/// test; an error when the two walks do not find the same hits (then the rates would compare
-/// different work).
-fn cwbvh_ray_throughput(scene: &PackedScene, batches: &[Vec<Ray>; 3]) -> Result<(Vec<RayResult>, f64), String> {
-    use obvhs::ray::{Ray as ORay, RayHit};
-    let tris: Vec<obvhs::triangle::Triangle> = scene
-        .triangles
-        .iter()
-        .map(|t| {
-            let (p0, e1, e2) = (Vec3::from(t.p0), Vec3::from(t.e1), Vec3::from(t.e2));
-            obvhs::triangle::Triangle { v0: p0.into(), v1: (p0 + e1).into(), v2: (p0 + e2).into() }
-        })
-        .collect();
-    let t = Instant::now();
-    let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
-        &tris,
-        obvhs::BvhBuildParams::medium_build(),
-        &mut std::time::Duration::default(),
-    );
-    let build_seconds = t.elapsed().as_secs_f64();
-    let intersect = |ray: &ORay, id: usize| {
-        let tri = &scene.triangles[bvh.primitive_indices[id] as usize];
-        let r = crate::cpu::bvh::intersect_triangle(&Ray { origin: ray.origin.into(), dir: ray.direction.into() }, tri);
-        if r.x >= crate::cpu::bvh::INF { f32::INFINITY } else { r.x }
-    };
-    let closest = |rays: &[Ray]| {
-        rays.par_iter()
-            .map(|r| {
-                let mut hit = RayHit::none();
-                bvh.ray_traverse(ORay::new_inf(r.origin.into(), r.dir.into()), &mut hit, intersect);
-                hit.t.min(1e30)
-            })
-            .sum::<f32>()
-    };
-    let result = |kind: &'static str, rays: &[Ray], seconds: f64| RayResult::new(kind, rays.len(), seconds);
-    let [primary, shadow, diffuse] = batches;
-    // The comparison is only meaningful if both walks find the same hits.
-    for rays in [primary, diffuse] {
-        let differ = rays
-            .par_iter()
-            .filter(|r| {
-                let mut hit = RayHit::none();
-                bvh.ray_traverse(ORay::new_inf(r.origin.into(), r.dir.into()), &mut hit, intersect);
-                let ours = intersect_closest(scene, r);
-                let ours = if ours.tri == crate::cpu::bvh::NO_HIT { f32::INFINITY } else { ours.t };
-                ours != hit.t && (ours - hit.t).abs() > 1e-4 * ours.abs().max(1.0)
-            })
-            .count();
-        if differ * 1000 > rays.len() {
-            return Err(format!("obvhs's CWBVH walk and ours disagree on {differ} of {} rays", rays.len()));
-        }
-    }
-    let rates = vec![
-        result(
-            "primary",
-            primary,
-            best_of(|| {
-                std::hint::black_box(closest(primary));
-            }),
-        ),
-        result(
-            "shadow",
-            shadow,
-            best_of(|| {
-                let blocked = shadow
-                    .par_iter()
-                    .filter(|r| !bvh.ray_traverse_miss(ORay::new(r.origin.into(), r.dir.into(), 0.0, 0.999), intersect))
-                    .count();
-                std::hint::black_box(blocked);
-            }),
-        ),
-        result(
-            "diffuse",
-            diffuse,
-            best_of(|| {
-                std::hint::black_box(closest(diffuse));
-            }),
-        ),
-    ];
-    Ok((rates, build_seconds))
+    vec![primary_result, shadow_result, diffuse_result]
 }
 
 /// Seconds of one run of `f`: the fastest of at least 5 runs and 0.3 s (a batch of ~65k rays
@@ -519,15 +424,9 @@ pub fn format_report(r: &BenchReport) -> String {
     }
     let rates = |rays: &[RayResult]| rays.iter().map(|x| format!("{:.2}", x.mrays_per_second)).collect::<Vec<_>>();
     s += "\nBVH traversal (M rays/s): primary / shadow / diffuse bounce\n";
-    s += &format!("{:<14} {:<24} {:<24} {}\n", "scene", "CPU reference", "GPU kernel", "CPU, obvhs's CWBVH walk");
+    s += &format!("{:<14} {:<24} {}\n", "scene", "CPU reference", "GPU kernel (the same rays)");
     for sc in &r.scenes {
-        s += &format!(
-            "{:<14} {:<24} {:<24} {}\n",
-            sc.scene,
-            rates(&sc.rays).join(" / "),
-            rates(&sc.gpu_rays).join(" / "),
-            rates(&sc.cwbvh_rays).join(" / ")
-        );
+        s += &format!("{:<14} {:<24} {}\n", sc.scene, rates(&sc.rays).join(" / "), rates(&sc.gpu_rays).join(" / "));
     }
     s
 }

@@ -4,6 +4,9 @@
 //! tested from both sides, entering (η = 1.5) and leaving (η = 1/1.5, with total internal
 //! reflection).
 
+mod common;
+
+use common::chi2::{self, direction};
 use glam::Vec3;
 use std::f32::consts::PI;
 use veach::cpu::bsdf::{bsdf_eval, bsdf_pdf, bsdf_sample};
@@ -50,116 +53,34 @@ fn cases() -> Vec<(String, PackedMaterial, f32)> {
     v
 }
 
-fn direction(cos_theta: f32, phi: f32) -> Vec3 {
-    let s = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    Vec3::new(s * phi.cos(), s * phi.sin(), cos_theta)
-}
-
-/// Upper tail of the chi-square distribution (Wilson–Hilferty normal approximation).
-fn chi2_p_value(chi2: f64, dof: f64) -> f64 {
-    let z = ((chi2 / dof).powf(1.0 / 3.0) - (1.0 - 2.0 / (9.0 * dof))) / (2.0 / (9.0 * dof)).sqrt();
-    0.5 * erfc(z / std::f64::consts::SQRT_2)
-}
-
-fn erfc(x: f64) -> f64 {
-    // Numerical Recipes' erfc, relative error < 1.2e-7.
-    let z = x.abs();
-    let t = 1.0 / (1.0 + 0.5 * z);
-    let r = t
-        * (-z * z - 1.26551223
-            + t * (1.00002368
-                + t * (0.37409196
-                    + t * (0.09678418
-                        + t * (-0.18628806
-                            + t * (0.27886807
-                                + t * (-1.13520398 + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
-            .exp();
-    if x >= 0.0 { r } else { 2.0 - r }
-}
-
 #[test]
 fn bsdf_sample_matches_pdf_chi_square() {
-    const THETA: usize = 20;
-    const PHI: usize = 40;
-    const N: usize = 400_000;
-    // Sub-cells per bin side: the midpoint rule must resolve the α = 0.09 lobe (12 is too coarse).
-    const SUB: usize = 32;
-    // The bins at the poles, where the refracted lobe of glass concentrates, get 8× more.
-    const POLE_SUB: usize = 256;
+    // Sub-cells per bin side: the midpoint rule must resolve the α = 0.09 lobe (12 is too
+    // coarse); the bins at the poles, where the refracted lobe of glass concentrates, get 8×.
+    let bins = chi2::SphereBins { theta: 20, phi: 40, sub: 32, pole_sub: 256 };
     let mut rng = Lcg(1);
-    let mut tests = 0;
     let n_cases = cases().len() * 3;
     for (name, m, eta) in cases() {
         for theta_o in [10f32, 45.0, 80.0] {
             let t = theta_o.to_radians();
             let wo = Vec3::new(t.sin(), 0.0, t.cos());
-            // Observed: histogram over (cos θ, φ) ∈ [−1, 1] × [0, 2π), plus failed samples.
-            let mut observed = vec![0f64; THETA * PHI + 1];
-            for _ in 0..N {
-                let u = Vec3::new(rng.f(), rng.f(), rng.f());
-                let s = bsdf_sample(&m, wo, u, eta);
+            let what = format!("{name} θo={theta_o}");
+            let sample = || {
+                let s = bsdf_sample(&m, wo, Vec3::new(rng.f(), rng.f(), rng.f()), eta);
                 if s.pdf <= 0.0 {
-                    observed[THETA * PHI] += 1.0;
-                    continue;
+                    return None;
                 }
                 assert!(!s.delta, "{name}: no Dirac lobe here");
                 let pdf = bsdf_pdf(&m, wo, s.wi, eta);
                 assert!((pdf - s.pdf).abs() <= 1e-3 * pdf, "{name}: sample pdf {} vs pdf() {pdf}", s.pdf);
-                let i = (((s.wi.z + 1.0) * 0.5 * THETA as f32) as usize).min(THETA - 1);
-                let mut phi = s.wi.y.atan2(s.wi.x);
-                if phi < 0.0 {
-                    phi += 2.0 * PI;
-                }
-                let j = ((phi / (2.0 * PI) * PHI as f32) as usize).min(PHI - 1);
-                observed[i * PHI + j] += 1.0;
-            }
-            // Expected: N × ∫ pdf dω over each bin (dω = dcosθ dφ), by a midpoint rule.
-            let mut expected = vec![0f64; THETA * PHI + 1];
-            let dp = 2.0 * std::f64::consts::PI / (PHI * SUB) as f64;
-            let mut total = 0.0;
-            for row in 0..THETA {
-                let sub = if row == 0 || row == THETA - 1 { POLE_SUB } else { SUB };
-                let dc = 2.0 / (THETA * sub) as f64;
-                for i in 0..sub {
-                    let c = -1.0 + 2.0 * row as f64 / THETA as f64 + (i as f64 + 0.5) * dc;
-                    for j in 0..PHI * SUB {
-                        let p = (j as f64 + 0.5) * dp;
-                        let pdf = bsdf_pdf(&m, wo, direction(c as f32, p as f32), eta) as f64 * dc * dp;
-                        expected[row * PHI + j / SUB] += pdf * N as f64;
-                        total += pdf;
-                    }
-                }
-            }
-            assert!(total < 1.0 + 2e-3, "{name} θo={theta_o}: pdf integrates to {total}");
-            expected[THETA * PHI] = (1.0 - total).max(0.0) * N as f64;
-            // Pool bins expecting fewer than 5 samples, then Pearson's statistic.
-            let (mut chi2, mut dof, mut pool_o, mut pool_e) = (0.0, 0.0, 0.0, 0.0);
-            for (o, e) in observed.iter().zip(&expected) {
-                if *e < 5.0 {
-                    pool_o += o;
-                    pool_e += e;
-                } else {
-                    chi2 += (o - e) * (o - e) / e;
-                    dof += 1.0;
-                }
-            }
-            if pool_e >= 5.0 {
-                chi2 += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
-                dof += 1.0;
-            } else {
-                assert!(pool_o <= 10.0 + pool_e * 5.0, "{name}: {pool_o} samples where pdf ≈ 0");
-            }
-            dof -= 1.0;
-            let p = chi2_p_value(chi2, dof);
-            tests += 1;
-            // 1 % significance, Šidák-corrected over all cases.
-            assert!(
-                p > 1.0 - 0.99f64.powf(1.0 / n_cases as f64),
-                "{name} θo={theta_o}: chi² = {chi2:.1}, dof {dof}, p = {p:.2e}"
-            );
+                Some(s.wi)
+            };
+            let r = chi2::sphere(&what, bins, 400_000, sample, |wi| bsdf_pdf(&m, wo, wi, eta) as f64);
+            assert!(r.total < 1.0 + 2e-3, "{what}: pdf integrates to {}", r.total);
+            // 1 % significance over all cases.
+            r.assert_passes(&what, 0.01, n_cases);
         }
     }
-    assert_eq!(tests, n_cases);
 }
 
 #[test]

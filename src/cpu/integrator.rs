@@ -49,7 +49,8 @@ fn connect(
     f * wi_local.z.abs() * ls.radiance
 }
 
-fn unoccluded(scene: &PackedScene, origin: Vec3, ls: &LightSample) -> bool {
+/// Whether nothing blocks the segment from `origin` to the light sample (twin of `unoccluded`).
+pub fn unoccluded(scene: &PackedScene, origin: Vec3, ls: &LightSample) -> bool {
     if ls.dist == INF {
         return !occluded(scene, &Ray { origin, dir: ls.wi }, INF);
     }

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod build;
+pub mod chi2;
 pub mod cli;
 
 use glam::Vec3;

@@ -237,7 +237,7 @@ pub struct RenderArgs {
     /// Save the film and the job to this EXR periodically and at exit, for --resume.
     #[arg(long)]
     pub checkpoint: Option<PathBuf>,
-    /// Seconds between checkpoints.
+    /// Seconds between checkpoints (0: after every chunk of samples).
     #[arg(long, default_value_t = 60.0, value_parser = parse_seconds, allow_negative_numbers = true)]
     pub checkpoint_every: f64,
     /// Continue the render saved in this checkpoint (or any EXR veach wrote) to its target.
@@ -303,10 +303,10 @@ pub fn parse_positive(s: &str) -> Result<f32, String> {
     if v.is_finite() && v > 0.0 { Ok(v) } else { Err(format!("{v}: expected a finite number > 0")) }
 }
 
-/// Seconds: finite and > 0.
+/// Seconds: finite and ≥ 0 (0 checkpoints after every chunk).
 pub fn parse_seconds(s: &str) -> Result<f64, String> {
     let v: f64 = s.trim().parse().map_err(|e| format!("'{s}': {e}"))?;
-    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(format!("{v}: expected a finite number of seconds > 0")) }
+    if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(format!("{v}: expected a finite number of seconds ≥ 0")) }
 }
 
 impl LookArgs {

@@ -1,0 +1,177 @@
+//! Light sampling, environment-map sampling, the triangle warp and the thin lens draw what
+//! their pdfs claim: the shared chi-square harness (tests/common/chi2.rs), as for the BSDFs.
+
+mod common;
+
+use common::build::{GltfBuilder, MeshData};
+use common::chi2::{self, SphereBins};
+use glam::{Vec2, Vec3};
+use serde_json::json;
+use veach::cpu::bvh::{NO_HIT, Ray, intersect_closest};
+use veach::cpu::environment::{environment_pdf, sample_environment};
+use veach::cpu::lights::{light_pdf, sample_light};
+use veach::cpu::sampling::{sample_uniform_disk, sample_uniform_triangle};
+use veach::params::Params;
+use veach::{Environment, EnvironmentMap, PackedScene, Settings};
+
+struct Lcg(u64);
+impl Lcg {
+    fn f(&mut self) -> f32 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// A sky brighter towards +Y and in one hot spot: far from uniform in every direction.
+fn sky() -> EnvironmentMap {
+    let (w, h) = (32u32, 16u32);
+    let texels = (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let up = 1.0 + 4.0 * (1.0 - y as f32 / h as f32);
+            let spot = if (10..13).contains(&x) && (4..6).contains(&y) { 40.0 } else { 0.0 };
+            Vec3::new(up + spot, up, 0.5 * up + spot)
+        })
+        .collect();
+    EnvironmentMap { width: w, height: h, texels }
+}
+
+/// Three lamps of different size, power and orientation around the origin, disjoint in
+/// direction as seen from it (so the density of a direction is one lamp's), and a sky.
+fn lamps(with_sky: bool) -> (PackedScene, Params) {
+    const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = GltfBuilder::new(dir.path(), "lamps");
+    for (k, (emission, half, translation, rotation)) in [
+        ([8.0, 8.0, 8.0], 0.5, [0.0, 2.0, 0.0], [H, 0.0, 0.0, H]),
+        ([2.0, 1.0, 0.5], 1.5, [3.0, 0.0, 0.0], [0.0, -H, 0.0, H]),
+        ([20.0, 20.0, 20.0], 0.2, [0.0, -0.5, -1.0], [0.0, 0.0, 0.0, 1.0]),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let m = b.material(json!({"emissiveFactor": emission, "name": format!("lamp{k}")}));
+        let mesh = b.mesh(&MeshData::quad(-half, -half, half, half, 0.0, MeshData::UPRIGHT), m);
+        b.node(json!({"mesh": mesh, "translation": translation, "rotation": rotation}));
+    }
+    b.camera(0.8, 1.0, [0.0, 0.0, 5.0]);
+    let (scene, camera) = common::load_pair(&b.write(), None).unwrap();
+    let mut packed = PackedScene::new(&scene);
+    let env = if with_sky { Environment::map(sky(), Vec3::ONE) } else { Environment::constant(Vec3::ZERO) };
+    packed.set_environment(&env);
+    let params = Params::new(&camera, &Settings::default(), Settings::default().window(), &packed);
+    (packed, params)
+}
+
+/// The densities of direction `wi` from `origin` under `sample_light`'s two techniques: the
+/// environment's, and the lamp's the ray meets (front faces only), as the integrator's MIS
+/// weights use them. The environment's radiance is blocked where a lamp is, so a sample
+/// reports the density of the technique that drew it; the directions are drawn from the sum.
+fn light_densities(scene: &PackedScene, params: &Params, origin: Vec3, wi: Vec3) -> (f64, f64) {
+    let env = if params.env_select > 0.0 { environment_pdf(scene, params, wi) as f64 } else { 0.0 };
+    let hit = intersect_closest(scene, &Ray { origin, dir: wi });
+    let mut lamp = 0.0;
+    if hit.tri != NO_HIT {
+        let tri = &scene.triangles[hit.tri as usize];
+        let n = Vec3::from(tri.e1).cross(Vec3::from(tri.e2)).normalize();
+        let cos = -wi.dot(n);
+        if tri.light_pdf_area > 0.0 && cos > 0.0 {
+            lamp = light_pdf(params, tri, hit.t * hit.t, cos) as f64;
+        }
+    }
+    (env, lamp)
+}
+
+#[test]
+fn light_sampling_matches_its_pdf() {
+    let cases = [(false, Vec3::ZERO), (true, Vec3::ZERO), (true, Vec3::new(0.3, 0.4, -0.2))];
+    for (with_sky, origin) in cases {
+        let (scene, params) = lamps(with_sky);
+        assert_eq!(params.light_count, 6, "three quads, two triangles each");
+        let mut rng = Lcg(3);
+        let what = format!("sample_light (sky {with_sky}, from {origin})");
+        let sample = || {
+            let ls = sample_light(&scene, &params, origin, Vec3::new(rng.f(), rng.f(), rng.f()));
+            if ls.pdf <= 0.0 {
+                return None;
+            }
+            // The pdf a sample reports is its technique's density of its direction.
+            let (env, lamp) = light_densities(&scene, &params, origin, ls.wi);
+            let close = |d: f64| (d - ls.pdf as f64).abs() <= 2e-3 * d + 1e-6;
+            assert!(close(env) || close(lamp), "{what}: pdf {} vs densities {env}, {lamp}", ls.pdf);
+            Some(ls.wi)
+        };
+        // The lamps' silhouettes cut bins: 64² midpoint cells a bin resolve the slivers.
+        let bins = SphereBins { theta: 24, phi: 48, sub: 64, pole_sub: 64 };
+        let density = |wi| {
+            let (env, lamp) = light_densities(&scene, &params, origin, wi);
+            env + lamp
+        };
+        let r = chi2::sphere(&what, bins, 300_000, sample, density);
+        assert!(r.total > 0.99 && r.total < 1.01, "{what}: the density integrates to {}", r.total);
+        r.assert_passes(&what, 0.01, cases.len());
+    }
+}
+
+#[test]
+fn environment_sampling_matches_its_pdf() {
+    let mut scene = PackedScene::new(&veach::Scene::default());
+    scene.set_environment(&Environment::map(sky(), Vec3::ONE));
+    let camera = veach::Camera::from_matrix("c".into(), glam::Mat4::IDENTITY, 0.8);
+    let params = Params::new(&camera, &Settings::default(), Settings::default().window(), &scene);
+    assert_eq!(params.env_select, 1.0);
+    let mut rng = Lcg(5);
+    let sample = || Some(sample_environment(&scene, &params, Vec2::new(rng.f(), rng.f())));
+    // Texel edges (uniform in θ) cut the bins (uniform in cos θ): 32² cells a bin.
+    let bins = SphereBins { theta: 32, phi: 64, sub: 32, pole_sub: 32 };
+    let r = chi2::sphere("sample_environment", bins, 400_000, sample, |wi| environment_pdf(&scene, &params, wi) as f64);
+    assert!((r.total - 1.0).abs() < 5e-3, "the environment pdf integrates to {}", r.total);
+    r.assert_passes("sample_environment", 0.01, 1);
+}
+
+#[test]
+fn triangle_and_lens_warps_match_their_pdfs() {
+    let mut rng = Lcg(7);
+    let r = chi2::plane(
+        "sample_uniform_triangle",
+        (Vec2::ZERO, Vec2::ONE),
+        (20, 8),
+        200_000,
+        || Some(sample_uniform_triangle(Vec2::new(rng.f(), rng.f()))),
+        // Midpoints of the cells the edge x + y = 1 cuts lie on it: half of such a cell is in.
+        |b| match b.x + b.y - 1.0 {
+            d if d.abs() < 1e-5 => 1.0,
+            d if d < 0.0 => 2.0,
+            _ => 0.0,
+        },
+    );
+    r.assert_passes("sample_uniform_triangle", 0.01, 2);
+    let r = chi2::plane(
+        "sample_uniform_disk (the thin lens)",
+        (Vec2::splat(-1.0), Vec2::ONE),
+        // The circle cuts cells: 64² a bin.
+        (20, 64),
+        200_000,
+        || Some(sample_uniform_disk(Vec2::new(rng.f(), rng.f()))),
+        |p| if p.length_squared() <= 1.0 { std::f64::consts::FRAC_1_PI } else { 0.0 },
+    );
+    r.assert_passes("sample_uniform_disk (the thin lens)", 0.01, 2);
+}
+
+/// The harness rejects a sampler that does not draw its pdf (a 5 % distortion).
+#[test]
+fn the_harness_detects_a_wrong_pdf() {
+    let mut rng = Lcg(9);
+    let r = chi2::plane(
+        "skewed",
+        (Vec2::ZERO, Vec2::ONE),
+        (20, 4),
+        200_000,
+        || {
+            let u = Vec2::new(rng.f(), rng.f());
+            Some(Vec2::new(u.x.powf(1.05), u.y))
+        },
+        |_| 1.0,
+    );
+    assert!(r.p < 1e-6, "a skewed sampler passed: {r:?}");
+}
