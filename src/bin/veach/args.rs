@@ -1,4 +1,5 @@
 //! The command line's schema: subcommands and their flags, and the flag parsers.
+#![cfg_attr(not(all(feature = "viewer", feature = "bench")), allow(dead_code))]
 
 use clap::{Parser, Subcommand};
 use glam::Vec3;
@@ -22,6 +23,7 @@ pub enum Command {
     /// Render a glTF 2.0 scene (.gltf/.glb) to a PNG (tone-mapped) or EXR (linear).
     Render(RenderArgs),
     /// Open the interactive preview window (egui), refining progressively on the GPU.
+    #[cfg(feature = "viewer")]
     View(ViewArgs),
     /// Merge renders of disjoint sample ranges or tiles (EXRs written by veach) into one image.
     Merge(MergeArgs),
@@ -30,6 +32,7 @@ pub enum Command {
     /// Plot RMSE against render time (log-log) for renders made with --reference and
     /// --stats-json: compare samplers, estimators and backends at equal time.
     PlotConvergence(PlotArgs),
+    #[cfg(feature = "bench")]
     /// Benchmark: the Cornell box, the Veach scene and a generated ~260k-triangle scene on
     /// each backend (samples/s), with load and BVH-build times, geometry bytes per triangle
     /// and BVH traversal throughput. See BENCHMARKS.md and bench/compare-mitsuba.sh.

@@ -1,6 +1,7 @@
 //! The `veach` command line: a thin shell over the library, one file per subcommand.
 
 mod args;
+#[cfg(feature = "bench")]
 mod bench;
 mod info;
 mod label;
@@ -9,6 +10,7 @@ mod plot;
 mod plot_image;
 mod render;
 mod strategies;
+#[cfg(feature = "viewer")]
 mod view;
 
 use clap::Parser;
@@ -39,8 +41,10 @@ fn main() -> ExitCode {
     let result = match cli.command {
         args::Command::Render(a) => render::run(&a),
         args::Command::Merge(a) => done(merge::run(&a)),
+        #[cfg(feature = "viewer")]
         args::Command::View(a) => done(view::run(a)),
         args::Command::Strategies(a) => done(strategies::run(&a)),
+        #[cfg(feature = "bench")]
         args::Command::Bench(a) => done(bench::run(&a)),
         args::Command::PlotConvergence(a) => done(plot::run(&a)),
         args::Command::Info { scene } => done(info::run(scene.as_deref())),
