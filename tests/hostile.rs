@@ -165,7 +165,7 @@ fn mutated_assets_never_panic() {
         .collect();
     let hostile =
         [json!(-1), json!(0), json!(1), json!(3), json!(65535), json!(4294967295u64), json!(1e20), json!(0.5)];
-    let (mut loaded, mut refused, mut inputs) = (0, 0, 0);
+    let (mut loaded, mut refused, mut inputs, mut gpu_runs) = (0, 0, 0, 0usize);
     let start = std::time::Instant::now();
     for round in 0..3000 {
         let base = &originals[round % originals.len()];
@@ -204,9 +204,50 @@ fn mutated_assets_never_panic() {
             }
         };
         inputs += 1;
-        let result = std::panic::catch_unwind(|| load_bytes(&bytes, None).map(|s| s.triangles.len()));
+        let result = std::panic::catch_unwind(|| load_bytes(&bytes, None));
         match result {
-            Ok(Ok(_)) => loaded += 1,
+            Ok(Ok(scene)) => {
+                loaded += 1;
+                // What loads renders without a panic and with no non-finite sample, on the CPU
+                // engine always and on the GPU for the first few (each GPU renderer compiles
+                // its pipeline).
+                let gpu_turn = gpu_runs < 6;
+                let nonfinite = std::panic::catch_unwind(|| {
+                    let camera = scene.camera(None).ok()?;
+                    let packed = veach::PackedScene::new(&scene);
+                    let s = veach::Settings {
+                        width: 8,
+                        height: 8,
+                        max_depth: 4,
+                        env_color: Some([0.5; 3]),
+                        ..Default::default()
+                    };
+                    let mut counts = Vec::new();
+                    let ctxs = [None, if gpu_turn { common::gpu("mutated_assets_never_panic") } else { None }];
+                    for ctx in ctxs.into_iter().enumerate().filter(|(k, c)| *k == 0 || c.is_some()).map(|(_, c)| c) {
+                        let mut r = common::renderer(packed.clone(), &camera, &s, ctx).ok()?;
+                        r.render_samples(0, 2).ok()?;
+                        counts.push(r.film().ok()?.nonfinite_samples());
+                    }
+                    Some(counts)
+                });
+                match nonfinite {
+                    Ok(Some(counts)) => {
+                        gpu_runs += (counts.len() > 1) as usize;
+                        if counts.iter().any(|&c| c > 0) {
+                            let _ = std::fs::write(std::env::temp_dir().join("veach-nonfinite-input.gltf"), &bytes);
+                            panic!(
+                                "input {round} renders non-finite samples {counts:?} (saved to veach-nonfinite-input.gltf)"
+                            );
+                        }
+                    }
+                    Ok(None) => {}
+                    Err(_) => {
+                        let _ = std::fs::write(std::env::temp_dir().join("veach-panic-input.gltf"), &bytes);
+                        panic!("input {round} panicked while rendering (saved to veach-panic-input.gltf)");
+                    }
+                }
+            }
             Ok(Err(e)) => {
                 assert!(!e.is_empty() && !e.contains('\n'), "one line: {e}");
                 refused += 1;
@@ -341,4 +382,22 @@ fn degenerate_vertex_data_gives_no_non_finite_samples() {
         assert_eq!(film.nonfinite_samples(), 0, "gpu {gpu}: non-finite samples");
         assert!(film.samples() == 32 && film.mean(24 * 48 + 24).max_element() > 0.0, "gpu {gpu}: an empty image");
     }
+}
+
+#[test]
+fn hand_built_scenes_are_validated() {
+    let ok = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let scene = load_bytes(&triangle_gltf(&ok, &[0, 1, 2], None), None).unwrap();
+    assert!(veach::PackedScene::try_new(&scene).is_ok());
+    let mut bad = scene.clone();
+    bad.triangles[0].material = 99;
+    let e = veach::PackedScene::try_new(&bad).err().expect("material out of range").to_string();
+    assert!(e.contains("material 99"), "{e}");
+    let mut bad = scene.clone();
+    bad.textures.push(veach::scene::Texture { name: "t".into(), width: 4, height: 4, rgba: vec![0; 7] });
+    let e = veach::PackedScene::try_new(&bad).err().expect("short texture").to_string();
+    assert!(e.contains("texture 0 is 4x4"), "{e}");
+    let mut bad = scene;
+    bad.instances.push(veach::scene::Instance { mesh: 3, transform: glam::Mat4::IDENTITY });
+    assert!(veach::PackedScene::try_new(&bad).is_err());
 }

@@ -78,6 +78,14 @@ pub struct PackedScene {
 }
 
 impl PackedScene {
+    /// Packs a scene after `Scene::validate`: the way for scenes built by hand.
+    pub fn try_new(scene: &Scene) -> Result<PackedScene, crate::Error> {
+        scene.validate()?;
+        Ok(PackedScene::new(scene))
+    }
+
+    /// Packs a scene the loader made (valid by construction; an invalid one panics: use
+    /// `try_new` for scenes built by hand).
     pub fn new(scene: &Scene) -> PackedScene {
         let verts: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.positions).collect();
         let bvh = accel::build(&verts);

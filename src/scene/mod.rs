@@ -222,6 +222,38 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Checks what the loader guarantees and an embedder building a `Scene` by hand might not:
+    /// every material, mesh and texture index in range, every texture's pixels its size.
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        let fail = |m: String| Err(crate::Error::Input(format!("invalid scene: {m}")));
+        let materials = self.materials.len();
+        let triangles = self.triangles.iter().chain(self.meshes.iter().flat_map(|m| &m.triangles));
+        if let Some(t) = triangles.clone().find(|t| t.material as usize >= materials) {
+            return fail(format!("a triangle uses material {} of {materials}", t.material));
+        }
+        if let Some(t) = triangles.clone().find(|t| !t.positions.iter().all(|p| p.is_finite())) {
+            return fail(format!("a triangle has non-finite positions {:?}", t.positions));
+        }
+        if let Some(i) = self.instances.iter().find(|i| i.mesh as usize >= self.meshes.len()) {
+            return fail(format!("an instance draws mesh {} of {}", i.mesh, self.meshes.len()));
+        }
+        if let Some(i) = self.instances.iter().find(|i| !i.transform.is_finite() || i.transform.determinant() == 0.0) {
+            return fail(format!("an instance's transform {:?} cannot be inverted", i.transform));
+        }
+        for (k, t) in self.textures.iter().enumerate() {
+            if t.rgba.len() as u64 != t.width as u64 * t.height as u64 * 4 || t.width == 0 || t.height == 0 {
+                return fail(format!("texture {k} is {}x{} but holds {} bytes", t.width, t.height, t.rgba.len()));
+            }
+        }
+        for (k, m) in self.materials.iter().enumerate() {
+            let refs = [m.base_color_texture, m.metallic_roughness_texture, m.emissive_texture, m.normal_texture];
+            if let Some(r) = refs.iter().flatten().find(|r| r.texture as usize >= self.textures.len()) {
+                return fail(format!("material {k} uses texture {} of {}", r.texture, self.textures.len()));
+            }
+        }
+        Ok(())
+    }
+
     pub fn bounds(&self) -> Bounds {
         let mut b = Bounds::empty();
         for t in &self.triangles {

@@ -110,7 +110,8 @@ pub fn plot_loglog(series: &[Series], x_label: &str, y_label: &str) -> RgbImage 
         }
         // Legend, top right.
         let y = TOP as u32 + 12 + 22 * k as u32;
-        let lx = (LEFT + pw) as u32 - 20 - text_width(&s.label, 2) - 40;
+        // A long label starts at the plot's left edge rather than wrapping below zero.
+        let lx = ((LEFT + pw) as u32).saturating_sub(20 + text_width(&s.label, 2) + 40).max(LEFT as u32);
         line(&mut img, (lx as f64, y as f64 + 7.0), (lx as f64 + 30.0, y as f64 + 7.0), color, 3.0, false);
         draw_text(&mut img, lx + 38, y, &s.label, 2, PALETTE[k % PALETTE.len()]);
     }

@@ -20,6 +20,7 @@ pub fn convert_light(light: &gltf::khr_lights_punctual::Light, world: Mat4) -> O
     };
     let range = light.range().filter(|r| r.is_finite() && *r > 0.0).unwrap_or(f32::INFINITY);
     let ok = intensity.is_finite() && position.is_finite() && direction != Vec3::ZERO && direction.is_finite();
+    let intensity = intensity.min(Vec3::splat(super::material::MAX_RADIANCE));
     (ok && intensity.max_element() > 0.0).then_some(PunctualLight { kind, position, direction, intensity, range })
 }
 
@@ -34,5 +35,6 @@ pub fn environment_from_extras(extras: &gltf::json::Extras) -> Option<Vec3> {
     }
     let r = env.get("radiance")?.as_array()?;
     let c: Vec<f32> = r.iter().filter_map(|x| x.as_f64().map(|x| x as f32)).collect();
-    (c.len() == 3 && c.iter().all(|x| x.is_finite() && *x >= 0.0)).then(|| Vec3::new(c[0], c[1], c[2]))
+    let ok = c.len() == 3 && c.iter().all(|x| x.is_finite() && *x >= 0.0);
+    ok.then(|| Vec3::new(c[0], c[1], c[2]).min(Vec3::splat(super::material::MAX_RADIANCE)))
 }

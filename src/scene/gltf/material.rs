@@ -3,6 +3,10 @@
 use crate::scene::{AlphaMode, Material, TextureRef, Wrap};
 use glam::Vec3;
 
+/// Largest emitted radiance kept: far above any physical source in scene units, yet far from
+/// f32's overflow when divided by a small light pdf.
+pub const MAX_RADIANCE: f32 = 1e15;
+
 pub fn convert_material(m: &gltf::Material, image_slot: &[Option<u32>], warnings: &mut Vec<String>) -> Material {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, a] = pbr.base_color_factor();
@@ -66,10 +70,11 @@ pub fn convert_material(m: &gltf::Material, image_slot: &[Option<u32>], warnings
         warnings.push(format!("{name}: transmissionTexture is not supported; using transmissionFactor"));
     }
     Material {
-        base_color: sane3(Vec3::new(r, g, b)),
+        // glTF's factors are in [0, 1]; a hostile 1e20 would overflow a path's throughput.
+        base_color: sane3(Vec3::new(r, g, b)).min(Vec3::ONE),
         metallic: sane(pbr.metallic_factor(), 0.0, 1.0, 1.0),
         roughness: sane(pbr.roughness_factor(), 0.0, 1.0, 1.0),
-        emission: sane3(Vec3::from(m.emissive_factor()) * strength),
+        emission: sane3(Vec3::from(m.emissive_factor()) * strength).min(Vec3::splat(MAX_RADIANCE)),
         specular_factor: sane(specular_factor, 0.0, 1.0, 1.0),
         specular_color: sane3(specular_color),
         ior: sane(m.ior().unwrap_or(1.5), 1.0, 10.0, 1.5),
