@@ -6,20 +6,14 @@
 
 mod common;
 
+use common::rng::Lcg;
+
 use common::chi2::{self, direction};
 use glam::Vec3;
 use std::f32::consts::PI;
 use veach::cpu::bsdf::{bsdf_eval, bsdf_pdf, bsdf_sample};
 use veach::packed::{Material as PackedMaterial, pack_material};
 use veach::scene::Material;
-
-struct Lcg(u64);
-impl Lcg {
-    fn f(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
 
 fn material(base: f32, metallic: f32, roughness: f32, specular: f32) -> PackedMaterial {
     pack_material(&Material {

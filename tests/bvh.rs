@@ -7,17 +7,7 @@ use veach::scene::{Material, Scene, Triangle};
 
 mod common;
 
-/// A small deterministic generator for test inputs (not the renderer's RNG).
-struct Lcg(u64);
-impl Lcg {
-    fn f(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn v(&mut self) -> Vec3 {
-        Vec3::new(self.f(), self.f(), self.f())
-    }
-}
+use common::rng::Lcg;
 
 fn soup(count: usize, rng: &mut Lcg) -> Scene {
     let triangles = (0..count)

@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::rng::Lcg;
 use common::*;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -38,14 +39,6 @@ fn setup(map: EnvironmentMap) -> (PackedScene, Params) {
     let tile = Tile { x: 0, y: 0, width: 4, height: 4 };
     let params = Params::new(&camera, &veach::Settings { width: 4, height: 4, ..Default::default() }, tile, &packed);
     (packed, params)
-}
-
-struct Lcg(u64);
-impl Lcg {
-    fn f(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
 }
 
 #[test]

@@ -5,6 +5,8 @@
 
 mod common;
 
+use common::rng::Lcg;
+
 use common::cli::{assert_user_error, ok, s, temp_dir, veach};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -175,17 +177,6 @@ fn hostile_flags_exit_2() {
         args.extend_from_slice(flags);
         let o = veach(&args, &[]);
         assert_eq!(o.status.code(), Some(2), "--resume with {flags:?}: {}", String::from_utf8_lossy(&o.stderr));
-    }
-}
-
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        self.0 >> 33
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
     }
 }
 

@@ -3,6 +3,8 @@
 
 mod common;
 
+use common::rng::Lcg;
+
 use common::build::{GltfBuilder, MeshData};
 use common::chi2::{self, SphereBins};
 use glam::{Vec2, Vec3};
@@ -13,14 +15,6 @@ use veach::cpu::lights::{light_pdf, sample_light};
 use veach::cpu::sampling::{sample_uniform_disk, sample_uniform_triangle};
 use veach::params::Params;
 use veach::{Environment, EnvironmentMap, PackedScene, Settings};
-
-struct Lcg(u64);
-impl Lcg {
-    fn f(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
 
 /// A sky brighter towards +Y and in one hot spot: far from uniform in every direction.
 fn sky() -> EnvironmentMap {
