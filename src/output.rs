@@ -120,10 +120,34 @@ fn write_exr(film: &Film, path: &Path, job: Option<&Job>) -> Result<(), Error> {
     })
 }
 
+/// The exr decoder allocates every channel at the size its header declares before reading a
+/// pixel, and a failed allocation aborts the process: so the declared sizes are checked first,
+/// against the limits a veach film has (each side at most `MAX_IMAGE_SIDE`, all channels
+/// together at most `MAX_FILM_BYTES`, which a veach part of the largest film stays under).
+fn check_exr_size(path: &Path) -> Result<(), String> {
+    use crate::{MAX_FILM_BYTES, MAX_IMAGE_SIDE};
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| format!("cannot read EXR: {e}"))?;
+    for header in meta.headers.iter() {
+        let (w, h) = (header.layer_size.width() as u64, header.layer_size.height() as u64);
+        if w == 0 || h == 0 || w > MAX_IMAGE_SIDE as u64 || h > MAX_IMAGE_SIDE as u64 {
+            return Err(format!("EXR layer is {w}x{h}, outside 1..={MAX_IMAGE_SIDE} per side"));
+        }
+        let bytes: u64 = header.channels.list.iter().map(|c| w * h * c.sample_type.bytes_per_sample() as u64).sum();
+        if bytes > MAX_FILM_BYTES {
+            return Err(format!(
+                "EXR layer of {w}x{h} with {} channels needs {bytes} bytes, above veach's limit of {MAX_FILM_BYTES}",
+                header.channels.list.len()
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Reads back a film and its job from an EXR written by veach.
 pub fn read_film(path: &Path) -> Result<(Film, Job), crate::Error> {
     use exr::prelude::*;
     let fail = |m: String| crate::Error::Input(format!("{}: {m}", path.display()));
+    check_exr_size(path).map_err(fail)?;
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
