@@ -9,7 +9,9 @@
 // buffers, or for scenes beyond a storage binding's limit, textures (see geometry.wgsl).
 #include "geometry.wgsl"
 @group(0) @binding(4) var<storage, read> materials: array<Material>;
-@group(0) @binding(5) var<storage, read> lights: array<LightEntry>;
+// The alias table (LightEntry bits, one row each), then from params.tree_base the light
+// tree (LIGHT_NODE_ROWS rows per node) and from params.trail_base its trails, four per row.
+@group(0) @binding(5) var<storage, read> lights: array<vec4<u32>>;
 // Three rows per pixel (see film.wgsl): (Σ L high words, count), (Σ L low words, dropped
 // non-finite samples), (Σ L² as f32 bits, 0).
 @group(0) @binding(6) var<storage, read_write> film: array<vec4<u32>>;

@@ -54,6 +54,15 @@ const TRI_ALPHA: u32 = 4u;
 const TRI_TANGENT_SIGN_SHIFT: u32 = 3u;
 // Set on a triangle moved to world space by a mirroring instance: its winding is reversed.
 const TRI_MIRRORED: u32 = 64u;
+// Bits 8–31: the triangle's emitter index + 1 in the light tree (0: not an emitter).
+const TRI_EMITTER_SHIFT: u32 = 8u;
+
+const LIGHT_SAMPLER_POWER: u32 = 0u;
+const LIGHT_SAMPLER_TREE: u32 = 1u;
+// Light-tree nodes: rows per node, the leaf bit of the index word, the two-sided flag.
+const LIGHT_NODE_ROWS: u32 = 3u;
+const LIGHT_LEAF: u32 = 0x80000000u;
+const LIGHT_TWO_SIDED: u32 = 1u;
 
 // Per-triangle vertex attributes: octahedral normals and tangents, TEXCOORD_0.
 struct Attributes {
@@ -161,8 +170,18 @@ struct Params {
     instance_base: u32,
     // SAMPLER_INDEPENDENT or SAMPLER_SOBOL (sampler.wgsl).
     sampler: u32,
-    pad1: u32,
-    pad2: u32,
+    // LIGHT_SAMPLER_POWER or LIGHT_SAMPLER_TREE (power when the scene has no tree).
+    light_sampler: u32,
+    // Emitters in the light tree: emissive triangles (the first light_count, in alias table
+    // order), then point and spot lights.
+    tree_emitters: u32,
+    // Rows of `lights` where the tree's nodes and its emitters' trails start.
+    tree_base: u32,
+    trail_base: u32,
+    // The first punctual lights, sampled in an estimate of their own (all with the power
+    // sampler; the directional ones, which come first, with the tree).
+    separate_punctuals: u32,
+    pad: u32,
 }
 
 struct Ray {

@@ -56,6 +56,8 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
     var depth = 0u;
     var prev_pdf = 0.0;
     var prev_delta = true;
+    // The previous vertex as light selection saw it (for the tree's probability on a hit).
+    var prev_ctx = LightContext(vec3<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0), false);
     loop {
         let hit = intersect_closest(ray);
         depth += 1u;
@@ -90,7 +92,7 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
                 if (strategy == STRATEGY_LIGHT) {
                     w = 0.0;
                 } else if (strategy != STRATEGY_BSDF) {
-                    w = mis_weight(strategy, prev_pdf, light_pdf(tri, hit.t * hit.t, cos_hit));
+                    w = mis_weight(strategy, prev_pdf, light_pdf(prev_ctx, tri, hit.t * hit.t, cos_hit));
                 }
             }
             radiance += beta * m.emission * w;
@@ -108,21 +110,31 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
         let frame = frame_from_normal(ns);
         let wo = to_local(frame, -ray.dir);
 
-        // Next-event estimation: one light sample.
-        if (strategy != STRATEGY_BSDF && (params.light_count > 0u || params.env_select > 0.0)) {
+        // Next-event estimation: one light sample. With the BSDF strategy alone it still
+        // runs for the tree's Dirac lights, which nothing else can find.
+        let ctx = LightContext(point, ns, m.transmission <= 0.0);
+        let tree = params.light_sampler == LIGHT_SAMPLER_TREE;
+        let nee_lights = select(params.light_count, params.tree_emitters, tree);
+        var nee = nee_lights > 0u || params.env_select > 0.0;
+        if (strategy == STRATEGY_BSDF) {
+            nee = tree && params.tree_emitters > params.light_count;
+        }
+        if (nee) {
             let u_light = vec3<f32>(sample_1d(sampler), sample_2d(sampler));
-            let ls = sample_light(point, u_light);
-            let c = connect(m, frame, wo, eta, point, ng, ls);
-            if (max_component(c) > 0.0) {
-                var w = 1.0;
-                if (strategy != STRATEGY_LIGHT) {
-                    w = mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, to_local(frame, ls.wi), eta));
+            let ls = sample_light(ctx, u_light);
+            if (ls.delta || strategy != STRATEGY_BSDF) {
+                let c = connect(m, frame, wo, eta, point, ng, ls);
+                if (max_component(c) > 0.0) {
+                    var w = 1.0;
+                    if (strategy != STRATEGY_LIGHT && !ls.delta) {
+                        w = mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, to_local(frame, ls.wi), eta));
+                    }
+                    radiance += beta * c * (w / ls.pdf);
                 }
-                radiance += beta * c * (w / ls.pdf);
             }
         }
-        // Punctual lights: only next-event estimation can reach them, whatever the strategy.
-        if (PUNCTUAL_LIGHTS && params.punctual_count > 0u) {
+        // Punctual lights outside the tree: only next-event estimation can reach them.
+        if (PUNCTUAL_LIGHTS && params.separate_punctuals > 0u) {
             let ls = sample_punctual(point, sample_1d(sampler));
             radiance += beta * connect(m, frame, wo, eta, point, ng, ls) / max(ls.pdf, 1e-30);
         }
@@ -144,6 +156,7 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
         }
         prev_pdf = bs.pdf;
         prev_delta = bs.delta;
+        prev_ctx = ctx;
         ray = Ray(spawn_point(point, ng, wi), wi);
 
         if (depth >= params.rr_depth) {

@@ -1,14 +1,16 @@
-// Lights: emissive triangles and the environment. Light sampling picks the environment with
-// probability params.env_select, else a triangle in proportion to its power (area ×
-// luminance) through an alias table, then a point uniformly on it; the area pdf becomes a
-// solid-angle pdf r² / (|cos θ_light| · area). Triangles emit from their front face.
-// Punctual lights (KHR_lights_punctual) are Dirac lights: `sample_punctual` picks one
-// uniformly for a separate next-event estimate with no MIS, as nothing else can find them.
+// Lights: emissive triangles, point and spot lights, and the environment. Light sampling
+// picks the environment with probability params.env_select, else an emitter: by power
+// (area × luminance) through an alias table, or by the light tree (light_tree.wgsl); then a
+// point uniformly on the triangle; the area pdf becomes a solid-angle pdf
+// r² / (|cos θ_light| · area). Triangles emit from their front face. Punctual lights are
+// Dirac lights (no MIS): in the tree with the tree sampler (directional ones apart), else
+// `sample_punctual` picks one uniformly for a separate estimate.
 // Twin: src/cpu/lights.rs.
 #include "bindings.wgsl"
 #include "sampling.wgsl"
 #include "environment.wgsl"
 #include "material.wgsl"
+#include "light_tree.wgsl"
 
 struct LightSample {
     // Unit direction from the shading point to the light.
@@ -19,24 +21,54 @@ struct LightSample {
     // Unit geometric normal of the light (its emitting side).
     normal: vec3<f32>,
     radiance: vec3<f32>,
-    // Solid-angle density at the shading point; 0 when the point sees the back face.
+    // Solid-angle density at the shading point (the selection probability of a Dirac light);
+    // 0 when the point sees the back face.
     pdf: f32,
+    // A Dirac light: no BSDF sample can find it, so no MIS.
+    delta: bool,
 }
 
-fn sample_light(ref_point: vec3<f32>, u: vec3<f32>) -> LightSample {
+fn light_entry(slot: u32) -> LightEntry {
+    let r = lights[slot];
+    return LightEntry(r.x, r.y, bitcast<f32>(r.z), bitcast<f32>(r.w));
+}
+
+fn triangle_area(tri: Triangle) -> f32 {
+    return 0.5 * length(cross(tri.e1, tri.e2));
+}
+
+fn sample_light(ctx: LightContext, u: vec3<f32>) -> LightSample {
+    let ref_point = ctx.point;
     let env_select = params.env_select;
     if (u.x < env_select) {
         let wi = sample_environment(u.yz);
-        return LightSample(wi, INF, ref_point, -wi, environment_radiance(wi), environment_pdf(wi));
+        return LightSample(wi, INF, ref_point, -wi, environment_radiance(wi), environment_pdf(wi), false);
     }
-    let n = params.light_count;
-    let scaled = (u.x - env_select) / (1.0 - env_select) * f32(n);
-    let slot = min(u32(scaled), n - 1u);
-    var entry = lights[slot];
-    if (scaled - f32(slot) >= entry.prob) {
-        entry = lights[entry.alias_slot];
+    let u_select = (u.x - env_select) / (1.0 - env_select);
+    var triangle = 0u;
+    var select_pmf = 0.0;
+    if (params.light_sampler == LIGHT_SAMPLER_TREE) {
+        let choice = sample_light_tree(ctx, min(u_select, ONE_MINUS_EPSILON));
+        select_pmf = (1.0 - env_select) * choice.pmf;
+        if (select_pmf <= 0.0) {
+            return LightSample(ctx.normal, INF, ref_point, -ctx.normal, vec3<f32>(0.0), 0.0, false);
+        }
+        if (choice.emitter >= params.light_count) {
+            let l = punctual_light(params.separate_punctuals + choice.emitter - params.light_count);
+            return punctual_sample(l, ref_point, select_pmf);
+        }
+        triangle = light_entry(choice.emitter).triangle;
+    } else {
+        let n = params.light_count;
+        let scaled = u_select * f32(n);
+        let slot = min(u32(scaled), n - 1u);
+        var entry = light_entry(slot);
+        if (scaled - f32(slot) >= entry.prob) {
+            entry = light_entry(entry.alias_slot);
+        }
+        triangle = entry.triangle;
     }
-    let tri = load_triangle(entry.triangle);
+    let tri = load_triangle(triangle);
     let b = sample_uniform_triangle(u.yz);
     let point = tri.p0 + b.x * tri.e1 + b.y * tri.e2;
     let normal = normalize(cross(tri.e1, tri.e2));
@@ -47,17 +79,30 @@ fn sample_light(ref_point: vec3<f32>, u: vec3<f32>) -> LightSample {
     let cos_light = -dot(wi, normal);
     var radiance = materials[tri.material].emission;
     if (TEXTURES && materials[tri.material].emissive_texture.layer != NO_TEXTURE) {
-        radiance = material_at(materials[tri.material], triangle_uv(entry.triangle, b.x, b.y)).emission;
+        radiance = material_at(materials[tri.material], triangle_uv(triangle, b.x, b.y)).emission;
     }
     if (cos_light <= 0.0 || dist2 <= 0.0) {
-        return LightSample(wi, dist, point, normal, radiance, 0.0);
+        return LightSample(wi, dist, point, normal, radiance, 0.0, false);
     }
-    return LightSample(wi, dist, point, normal, radiance, light_pdf(tri, dist2, cos_light));
+    var pdf = (1.0 - env_select) * tri.light_pdf_area * dist2 / cos_light;
+    if (params.light_sampler == LIGHT_SAMPLER_TREE) {
+        pdf = select_pmf * dist2 / (cos_light * triangle_area(tri));
+    }
+    return LightSample(wi, dist, point, normal, radiance, pdf, false);
 }
 
-// Solid-angle density of sampling `tri` from a point at squared distance `dist2`.
-fn light_pdf(tri: Triangle, dist2: f32, cos_light: f32) -> f32 {
-    return (1.0 - params.env_select) * tri.light_pdf_area * dist2 / abs(cos_light);
+// Solid-angle density with which `sample_light` from `ctx` finds the point of `tri` a ray
+// reached at distance² `dist2` with cosine `cos_light` to the light's normal.
+fn light_pdf(ctx: LightContext, tri: Triangle, dist2: f32, cos_light: f32) -> f32 {
+    if (params.light_sampler != LIGHT_SAMPLER_TREE) {
+        return (1.0 - params.env_select) * tri.light_pdf_area * dist2 / abs(cos_light);
+    }
+    let emitter = tri.flags >> TRI_EMITTER_SHIFT;
+    if (emitter == 0u) {
+        return 0.0;
+    }
+    let pmf = (1.0 - params.env_select) * light_tree_pmf(ctx, emitter - 1u);
+    return pmf * dist2 / (abs(cos_light) * triangle_area(tri));
 }
 
 const PUNCTUAL_POINT: f32 = 0.0;
@@ -74,18 +119,20 @@ fn punctual_light(index: u32) -> Punctual {
     return Punctual(r0.xyz, r0.w, r1.xyz, r1.w, r2.xyz, r2.w, r3.x, 0.0, 0.0, 0.0);
 }
 
-// One punctual light chosen uniformly: `radiance` is the irradiance factor I/r² (point,
-// spot) or E (directional), glTF's window for `range`, spot cone falloff t² with
-// t = clamp((cos θ − cos outer) / (cos inner − cos outer)); `pdf` is the selection
-// probability.
+// One of the first `separate_punctuals` punctual lights, chosen uniformly.
 fn sample_punctual(ref_point: vec3<f32>, u: f32) -> LightSample {
-    let n = params.punctual_count;
+    let n = params.separate_punctuals;
     let index = min(u32(u * f32(n)), n - 1u);
-    let l = punctual_light(index);
-    let pdf = 1.0 / f32(n);
+    return punctual_sample(punctual_light(index), ref_point, 1.0 / f32(n));
+}
+
+// Light from punctual light `l` chosen with probability `pdf`: `radiance` is the irradiance
+// factor I/r² (point, spot) or E (directional), glTF's window for `range`, spot cone falloff
+// t² with t = clamp((cos θ − cos outer) / (cos inner − cos outer)).
+fn punctual_sample(l: Punctual, ref_point: vec3<f32>, pdf: f32) -> LightSample {
     if (l.kind != PUNCTUAL_POINT && l.kind != PUNCTUAL_SPOT) {
         let wi = -l.direction;
-        return LightSample(wi, INF, ref_point, l.direction, l.intensity, pdf);
+        return LightSample(wi, INF, ref_point, l.direction, l.intensity, pdf, true);
     }
     let to_light = l.position - ref_point;
     let dist2 = dot(to_light, to_light);
@@ -102,8 +149,8 @@ fn sample_punctual(ref_point: vec3<f32>, u: f32) -> LightSample {
         let t = clamp((cos_axis - l.cos_outer) / max(l.cos_inner - l.cos_outer, 1e-4), 0.0, 1.0);
         scale *= t * t;
     }
-    if (dist2 <= 0.0 || scale <= 0.0) {
-        return LightSample(wi, dist, l.position, -wi, vec3<f32>(0.0), 0.0);
+    if (dist2 <= 0.0 || scale <= 0.0 || pdf <= 0.0) {
+        return LightSample(wi, dist, l.position, -wi, vec3<f32>(0.0), 0.0, true);
     }
-    return LightSample(wi, dist, l.position, -wi, l.intensity * scale, pdf);
+    return LightSample(wi, dist, l.position, -wi, l.intensity * scale, pdf, true);
 }

@@ -24,8 +24,9 @@ fn trace_rays(@builtin(global_invocation_id) gid: vec3<u32>) {
         let n = normalize(cross(tri.e1, tri.e2));
         let ng = select(n, -n, dot(n, ray.dir) > 0.0);
         let point = tri.p0 + hit.u * tri.e1 + hit.v * tri.e2;
-        if (TRACE_KIND == 1u && (params.light_count > 0u || params.env_select > 0.0)) {
-            let ls = sample_light(point, vec3<f32>(sample_1d(&sampler), sample_2d(&sampler)));
+        if (TRACE_KIND == 1u && (params.light_count > 0u || params.tree_emitters > 0u || params.env_select > 0.0)) {
+            let ctx = LightContext(point, ng, false);
+            let ls = sample_light(ctx, vec3<f32>(sample_1d(&sampler), sample_2d(&sampler)));
             if (ls.pdf > 0.0 && unoccluded(offset_ray(point, ng), ls)) {
                 count += 1.0;
             }

@@ -23,11 +23,14 @@ pub struct BenchOptions {
     /// Spheres per side of the generated large scene's grid (each 128 × 64 segments, ~16k
     /// triangles): 4 gives ~262k triangles, Sponza-class.
     pub large_grid: u32,
+    /// Emitters of the generated light-tree build test (small triangles over a volume).
+    pub tree_emitters: usize,
 }
 
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct RenderResult {
     pub backend: String,
+    pub light_sampler: &'static str,
     pub adapter: String,
     pub seconds: f64,
     pub msamples_per_second: f64,
@@ -61,6 +64,13 @@ pub struct SceneResult {
     pub bvh_depth: u32,
     /// Geometry, attributes and BVH as uploaded (nodes + triangles + vertex attributes).
     pub geometry_bytes_per_triangle: f64,
+    /// Emitters in the light tree (triangles, point and spot lights), its nodes and depth.
+    pub light_tree_emitters: u32,
+    pub light_tree_nodes: usize,
+    pub light_tree_depth: u32,
+    pub light_tree_build_seconds: f64,
+    /// The light tree's nodes and trails as uploaded, per emitter.
+    pub light_tree_bytes_per_emitter: f64,
     pub renders: Vec<RenderResult>,
     /// Traversal on the CPU reference's BVH walk (same nodes and order as the GPU's).
     pub rays: Vec<RayResult>,
@@ -74,6 +84,51 @@ pub struct BenchReport {
     pub machine: String,
     pub cores: usize,
     pub scenes: Vec<SceneResult>,
+    pub light_tree_scale: TreeScale,
+}
+
+/// Building the light tree over many emitters (no rendering).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TreeScale {
+    pub emitters: usize,
+    pub nodes: usize,
+    pub depth: u32,
+    pub build_seconds: f64,
+    pub bytes_per_emitter: f64,
+}
+
+/// The light tree over `n` small one-sided triangles scattered through a unit cube, facing
+/// random ways, of powers spanning three decades.
+pub fn light_tree_scale(n: usize) -> TreeScale {
+    use crate::accel::light_bvh::LightBounds;
+    let mut state = 0x853c_49e6_748f_ea9bu64;
+    let mut f = move || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let emitters: Vec<LightBounds> = (0..n)
+        .map(|_| {
+            let p = Vec3::new(f(), f(), f());
+            let axis = Vec3::new(f() - 0.5, f() - 0.5, f() - 0.5).normalize_or(Vec3::Z);
+            LightBounds {
+                lo: p,
+                hi: p + 1e-3,
+                phi: 10f32.powf(3.0 * f()),
+                axis,
+                cos_o: 1.0,
+                cos_e: 0.0,
+                two_sided: false,
+            }
+        })
+        .collect();
+    let t = crate::packed::pack_light_tree_for_bench(&emitters);
+    TreeScale {
+        emitters: n,
+        nodes: t.0,
+        depth: t.1,
+        build_seconds: t.2,
+        bytes_per_emitter: t.3 as f64 / n.max(1) as f64,
+    }
 }
 
 /// Runs the benchmark; `progress` gets one line per step.
@@ -96,6 +151,8 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
         let geometry = std::mem::size_of_val(&packed.nodes[..])
             + std::mem::size_of_val(&packed.triangles[..])
             + std::mem::size_of_val(&packed.attributes[..]);
+        let tree_bytes = (packed.light_rows.len() - packed.tree_base as usize) * 16;
+        let emitters = packed.tree_emitters;
         let mut result = SceneResult {
             scene: name.to_string(),
             triangles: scene.triangles.len(),
@@ -105,6 +162,11 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
             bvh_nodes: packed.bvh_nodes,
             bvh_depth: packed.bvh_depth,
             geometry_bytes_per_triangle: geometry as f64 / tris as f64,
+            light_tree_emitters: emitters,
+            light_tree_nodes: packed.light_tree_nodes,
+            light_tree_depth: packed.light_tree_depth,
+            light_tree_build_seconds: packed.light_tree_seconds,
+            light_tree_bytes_per_emitter: if emitters > 0 { tree_bytes as f64 / emitters as f64 } else { 0.0 },
             renders: Vec::new(),
             rays: Vec::new(),
             gpu_rays: Vec::new(),
@@ -112,24 +174,30 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
         let settings =
             Settings { width: opts.width, height: opts.height, max_depth: opts.max_depth, ..Settings::default() };
         for &backend in backends {
-            progress(&format!("{name}: rendering on {backend:?}"));
-            let mut r = match (backend, &ctx) {
-                (Backend::Gpu, Some(ctx)) => Renderer::with_context(packed.clone(), &camera, &settings, ctx.clone())?,
-                _ => Renderer::new(packed.clone(), &camera, &settings, backend)?,
-            };
-            // One warm-up sample (shader compilation, first-touch allocations) is not timed.
-            r.render_samples(0, 1)?;
-            let t = Instant::now();
-            r.render_samples(1, opts.spp)?;
-            r.film()?;
-            let seconds = t.elapsed().as_secs_f64();
-            let samples = opts.width as f64 * opts.height as f64 * opts.spp as f64;
-            result.renders.push(RenderResult {
-                backend: format!("{backend:?}").to_lowercase(),
-                adapter: r.adapter_name(),
-                seconds,
-                msamples_per_second: samples / seconds / 1e6,
-            });
+            for light_sampler in crate::LightSampler::ALL {
+                progress(&format!("{name}: rendering on {backend:?}, {} light sampler", light_sampler.label()));
+                let settings = Settings { light_sampler, ..settings.clone() };
+                let mut r = match (backend, &ctx) {
+                    (Backend::Gpu, Some(ctx)) => {
+                        Renderer::with_context(packed.clone(), &camera, &settings, ctx.clone())?
+                    }
+                    _ => Renderer::new(packed.clone(), &camera, &settings, backend)?,
+                };
+                // One warm-up sample (shader compilation, first-touch allocations) is not timed.
+                r.render_samples(0, 1)?;
+                let t = Instant::now();
+                r.render_samples(1, opts.spp)?;
+                r.film()?;
+                let seconds = t.elapsed().as_secs_f64();
+                let samples = opts.width as f64 * opts.height as f64 * opts.spp as f64;
+                result.renders.push(RenderResult {
+                    backend: format!("{backend:?}").to_lowercase(),
+                    light_sampler: light_sampler.label(),
+                    adapter: r.adapter_name(),
+                    seconds,
+                    msamples_per_second: samples / seconds / 1e6,
+                });
+            }
         }
         progress(&format!("{name}: tracing ray batches"));
         let r = Renderer::new(packed, &camera, &settings, Backend::Cpu)?;
@@ -140,11 +208,14 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
         }
         results.push(result);
     }
+    progress(&format!("light tree over {} emitters", opts.tree_emitters));
+    let light_tree_scale = light_tree_scale(opts.tree_emitters);
     Ok(BenchReport {
         options: opts.clone(),
         machine: machine_name(),
         cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
         scenes: results,
+        light_tree_scale,
     })
 }
 
@@ -180,7 +251,7 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<Ra
             (Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2, ng, sampler.clone())
         })
         .collect();
-    let lit = params.light_count > 0 || params.env_select > 0.0;
+    let lit = params.light_count > 0 || params.tree_emitters > 0 || params.env_select > 0.0;
     let shadow: Vec<_> = if lit {
         surface
             .iter()
@@ -188,7 +259,11 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<Ra
                 let mut sampler = sampler.clone();
                 let u0 = sample_1d(&mut sampler);
                 let u12 = sample_2d(&mut sampler);
-                (offset_ray(*p, *ng), crate::cpu::lights::sample_light(scene, params, *p, Vec3::new(u0, u12.x, u12.y)))
+                let ctx = crate::cpu::light_tree::LightContext { point: *p, normal: *ng, reflect_only: false };
+                (
+                    offset_ray(*p, *ng),
+                    crate::cpu::lights::sample_light(scene, params, &ctx, Vec3::new(u0, u12.x, u12.y)),
+                )
             })
             .filter(|(_, ls)| ls.pdf > 0.0)
             .collect()
@@ -401,8 +476,8 @@ pub fn format_report(r: &BenchReport) -> String {
         o.width, o.height, o.spp, o.max_depth, r.machine, r.cores
     );
     s += &format!(
-        "{:<14} {:>9} {:>9} {:>9} {:>9} {:>8}  {:<8} {:>10} {:>9}\n",
-        "scene", "triangles", "load s", "BVH s", "nodes", "B/tri", "backend", "Msamples/s", "seconds"
+        "{:<14} {:>9} {:>9} {:>9} {:>9} {:>8}  {:<8} {:<6} {:>10} {:>9}\n",
+        "scene", "triangles", "load s", "BVH s", "nodes", "B/tri", "backend", "lights", "Msamples/s", "seconds"
     );
     for sc in &r.scenes {
         for (i, run) in sc.renders.iter().enumerate() {
@@ -419,7 +494,10 @@ pub fn format_report(r: &BenchReport) -> String {
             } else {
                 format!("{:<14} {:>9} {:>9} {:>9} {:>9} {:>8}", "", "", "", "", "", "")
             };
-            s += &format!("{head}  {:<8} {:>10.3} {:>9.2}\n", run.backend, run.msamples_per_second, run.seconds);
+            s += &format!(
+                "{head}  {:<8} {:<6} {:>10.3} {:>9.2}\n",
+                run.backend, run.light_sampler, run.msamples_per_second, run.seconds
+            );
         }
     }
     let rates = |rays: &[RayResult]| rays.iter().map(|x| format!("{:.2}", x.mrays_per_second)).collect::<Vec<_>>();
@@ -428,5 +506,22 @@ pub fn format_report(r: &BenchReport) -> String {
     for sc in &r.scenes {
         s += &format!("{:<14} {:<24} {}\n", sc.scene, rates(&sc.rays).join(" / "), rates(&sc.gpu_rays).join(" / "));
     }
+    s += "\nLight tree: emitters, nodes, depth, build s, bytes per emitter\n";
+    for sc in &r.scenes {
+        s += &format!(
+            "{:<14} {:>9} {:>9} {:>5} {:>9.3} {:>8.1}\n",
+            sc.scene,
+            sc.light_tree_emitters,
+            sc.light_tree_nodes,
+            sc.light_tree_depth,
+            sc.light_tree_build_seconds,
+            sc.light_tree_bytes_per_emitter
+        );
+    }
+    let t = &r.light_tree_scale;
+    s += &format!(
+        "{:<14} {:>9} {:>9} {:>5} {:>9.3} {:>8.1}\n",
+        "generated", t.emitters, t.nodes, t.depth, t.build_seconds, t.bytes_per_emitter
+    );
     s
 }

@@ -44,13 +44,14 @@ impl Job {
             return Err(format!("the scene differs ({} vs {})", self.scene.display(), other.scene.display()));
         }
         let (a, b) = (&self.settings, &other.settings);
-        let checks: [(&str, bool); 11] = [
+        let checks: [(&str, bool); 12] = [
             ("camera", a.camera == b.camera),
             ("image size", (a.width, a.height) == (b.width, b.height)),
             ("max depth", a.max_depth == b.max_depth),
             ("seed", a.seed == b.seed),
             ("strategy", a.strategy == b.strategy),
             ("sampler", a.sampler == b.sampler),
+            ("light sampler", a.light_sampler == b.light_sampler),
             ("environment map", a.env_map == b.env_map),
             ("environment color", a.env_color == b.env_color),
             ("environment strength", a.env_strength.to_bits() == b.env_strength.to_bits()),

@@ -3,7 +3,7 @@
 
 use crate::packed::PackedScene;
 use crate::scene::Camera;
-use crate::settings::{Settings, Tile};
+use crate::settings::{LightSampler, Settings, Tile};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
@@ -46,7 +46,18 @@ pub struct Params {
     pub instance_base: u32,
     /// How samples are generated: a `SamplerKind` id.
     pub sampler: u32,
-    pub pad: [u32; 2],
+    /// How emitters are picked: a `LightSampler` id (power when the scene has no tree).
+    pub light_sampler: u32,
+    /// Emitters in the light tree: emissive triangles (the first `light_count`, in alias
+    /// table order), then point and spot lights.
+    pub tree_emitters: u32,
+    /// Rows of the `lights` buffer where the tree's nodes and its emitters' trails start.
+    pub tree_base: u32,
+    pub trail_base: u32,
+    /// The first punctual lights, sampled in an estimate of their own: all of them with the
+    /// power sampler, the directional ones with the tree (they come first).
+    pub separate_punctuals: u32,
+    pub pad: u32,
 }
 
 /// Russian roulette starts once a path has this many segments.
@@ -69,6 +80,8 @@ impl Params {
     /// set up (a pinhole).
     pub fn new(camera: &Camera, settings: &Settings, tile: Tile, scene: &PackedScene) -> Params {
         let light_count = scene.lights.len() as u32;
+        let tree = settings.light_sampler == LightSampler::Tree && scene.tree_emitters > 0;
+        let lights = if tree { scene.tree_emitters } else { light_count };
         let (w, h) = (settings.width, settings.height);
         let environment = scene.environment;
         let tan_half = (0.5 * camera.yfov).tan();
@@ -91,7 +104,7 @@ impl Params {
             image_height: h,
             tile_x: tile.x,
             tile_y: tile.y,
-            env_select: env_select_probability(environment, scene.env_width > 0, scene.env_total, light_count),
+            env_select: env_select_probability(environment, scene.env_width > 0, scene.env_total, lights),
             env_width: scene.env_width,
             env_height: scene.env_height,
             env_total: scene.env_total,
@@ -102,7 +115,13 @@ impl Params {
             punctual_count: scene.punctual_count,
             instance_base: scene.instance_base,
             sampler: settings.sampler as u32,
-            pad: [0; 2],
+            light_sampler: if tree { LightSampler::Tree } else { LightSampler::Power } as u32,
+            tree_emitters: if tree { scene.tree_emitters } else { 0 },
+            tree_base: scene.tree_base,
+            trail_base: scene.trail_base,
+            separate_punctuals: if tree { scene.directional_count } else { scene.punctual_count },
+            pad: 0,
         }
     }
 }
+pub const LIGHT_SAMPLER_TREE: u32 = crate::LightSampler::Tree as u32;

@@ -55,6 +55,33 @@ pub enum SamplerKind {
     Sobol = 1,
 }
 
+/// How next-event estimation picks an emitter; the discriminants are the shaders'
+/// `LIGHT_SAMPLER_*` ids.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+#[repr(u32)]
+pub enum LightSampler {
+    /// By power alone (an alias table over emissive triangles; punctual lights uniformly, in
+    /// an estimate of their own); the default of renders saved before light samplers existed.
+    #[default]
+    Power = 0,
+    /// The light BVH: emitters (triangles, point and spot lights) chosen by their importance
+    /// to the shading point (distance, orientation, the surface's tangent plane).
+    Tree = 1,
+}
+
+impl LightSampler {
+    pub const ALL: [LightSampler; 2] = [LightSampler::Power, LightSampler::Tree];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            LightSampler::Power => "power",
+            LightSampler::Tree => "tree",
+        }
+    }
+}
+
 /// Which engine renders: the WGSL kernel through wgpu, or the CPU reference.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
@@ -123,6 +150,9 @@ pub struct Settings {
     /// Renders saved before samplers existed used independent numbers.
     #[serde(default)]
     pub sampler: SamplerKind,
+    /// Renders saved before light samplers existed sampled lights by power.
+    #[serde(default)]
+    pub light_sampler: LightSampler,
 }
 
 impl Default for Settings {
@@ -141,6 +171,7 @@ impl Default for Settings {
             aperture: 0.0,
             focus_distance: None,
             sampler: SamplerKind::Sobol,
+            light_sampler: LightSampler::Tree,
         }
     }
 }

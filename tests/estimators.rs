@@ -13,8 +13,20 @@ use veach::film::Film;
 const STRATEGIES: [Strategy; 4] = [Strategy::Bsdf, Strategy::Light, Strategy::MisBalance, Strategy::MisPower];
 
 fn render_strategy(scene: &str, strategy: Strategy, max_depth: u32, spp: u32, seed: u32) -> Film {
+    render_with(scene, strategy, veach::LightSampler::Tree, max_depth, spp, seed)
+}
+
+fn render_with(
+    scene: &str,
+    strategy: Strategy,
+    light_sampler: veach::LightSampler,
+    max_depth: u32,
+    spp: u32,
+    seed: u32,
+) -> Film {
     let mut s = settings(64, max_depth, seed);
     s.strategy = strategy;
+    s.light_sampler = light_sampler;
     render(&asset(scene), &s, spp, None)
 }
 
@@ -84,20 +96,28 @@ fn mis_pays_on_every_veach_plate() {
     for (k, p) in plates.iter().enumerate() {
         assert!(p.len() > 40, "plate {} covers {} pixels", k + 1, p.len());
     }
-    let films: Vec<Film> = STRATEGIES
-        .iter()
-        .enumerate()
-        .map(|(k, &s)| render_strategy("veach-mis.gltf", s, 2, 64, 200 + k as u32))
-        .collect();
-    for (k, pixels) in plates.iter().enumerate() {
-        let v: Vec<f64> = films.iter().map(|f| plate_variance(f, pixels)).collect();
-        let (bsdf, light, balance, power) = (v[0], v[1], v[2], v[3]);
-        let (best, worst) = (bsdf.min(light), bsdf.max(light));
-        eprintln!("plate {}: variance bsdf {bsdf:.4} light {light:.4} balance {balance:.4} power {power:.4}", k + 1);
-        // Veach's bound allows MIS a little above the best single strategy; we allow 50 %.
-        assert!(power <= 1.5 * best, "plate {}: power heuristic {power} vs best {best}", k + 1);
-        assert!(balance <= 1.5 * best, "plate {}: balance heuristic {balance} vs best {best}", k + 1);
-        assert!(power <= 0.5 * worst, "plate {}: power heuristic {power} vs worst {worst}", k + 1);
+    // Veach's figure with his light sampling (by power), and with the light tree, whose light
+    // samples are already good enough on the rough plates that MIS need not halve the worse
+    // strategy's variance there: for it only the bound near the best strategy is asserted.
+    for light_sampler in veach::LightSampler::ALL {
+        let films: Vec<Film> = STRATEGIES
+            .iter()
+            .enumerate()
+            .map(|(k, &s)| render_with("veach-mis.gltf", s, light_sampler, 2, 64, 200 + k as u32))
+            .collect();
+        for (k, pixels) in plates.iter().enumerate() {
+            let v: Vec<f64> = films.iter().map(|f| plate_variance(f, pixels)).collect();
+            let (bsdf, light, balance, power) = (v[0], v[1], v[2], v[3]);
+            let (best, worst) = (bsdf.min(light), bsdf.max(light));
+            let what = format!("plate {} ({} light sampler)", k + 1, light_sampler.label());
+            eprintln!("{what}: variance bsdf {bsdf:.4} light {light:.4} balance {balance:.4} power {power:.4}");
+            // Veach's bound allows MIS a little above the best single strategy; we allow 50 %.
+            assert!(power <= 1.5 * best, "{what}: power heuristic {power} vs best {best}");
+            assert!(balance <= 1.5 * best, "{what}: balance heuristic {balance} vs best {best}");
+            if light_sampler == veach::LightSampler::Power {
+                assert!(power <= 0.5 * worst, "{what}: power heuristic {power} vs worst {worst}");
+            }
+        }
     }
 }
 

@@ -25,14 +25,17 @@ fn fnv(words: &[u32]) -> u64 {
     h
 }
 
-/// (scene, max depth, sampler, expected hash of a 48×48 film of 4 samples, seed 7).
-const FILMS: &[(&str, u32, veach::SamplerKind, u64)] = &[
-    ("cornell-box.gltf", 8, veach::SamplerKind::Sobol, 0xe1da898f5d51b302),
-    ("cornell-box.gltf", 8, veach::SamplerKind::Independent, 0x114b9e2aa4a45558),
-    ("cornell-glass.gltf", 8, veach::SamplerKind::Sobol, 0xc0acbc95243005ef),
-    ("veach-mis.gltf", 2, veach::SamplerKind::Sobol, 0x306c85d221bc9d9b),
-    ("furnace-a080.gltf", 8, veach::SamplerKind::Sobol, 0x4020415887b55e33),
-    ("furnace-a100.gltf", 8, veach::SamplerKind::Independent, 0xdcf88cd2ca2f48b4),
+/// (scene, max depth, sampler, light sampler, expected hash of a 48×48 film of 4 samples,
+/// seed 7). The power rows are the films from before the light tree existed.
+const FILMS: &[(&str, u32, veach::SamplerKind, veach::LightSampler, u64)] = &[
+    ("cornell-box.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0xe1da898f5d51b302),
+    ("cornell-box.gltf", 8, veach::SamplerKind::Independent, veach::LightSampler::Power, 0x114b9e2aa4a45558),
+    ("cornell-glass.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0xc0acbc95243005ef),
+    ("veach-mis.gltf", 2, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0x306c85d221bc9d9b),
+    ("furnace-a080.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0x4020415887b55e33),
+    ("furnace-a100.gltf", 8, veach::SamplerKind::Independent, veach::LightSampler::Power, 0xdcf88cd2ca2f48b4),
+    ("cornell-box.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Tree, 0x0970f06d75e1c594),
+    ("veach-mis.gltf", 2, veach::SamplerKind::Sobol, veach::LightSampler::Tree, 0x8f72d05cec01fbf1),
 ];
 
 /// A scene that turns on every optional part of the kernel: a texture with alpha MASK, BLEND,
@@ -76,24 +79,28 @@ fn features_scene() -> PathBuf {
 /// The films this test renders: (name, scene file, settings).
 fn cases() -> Vec<(String, PathBuf, Settings)> {
     let mut out = Vec::new();
-    for &(scene, max_depth, sampler, _) in FILMS {
-        let settings = Settings { width: 48, height: 48, max_depth, seed: 7, sampler, ..Settings::default() };
-        out.push((format!("{scene} depth {max_depth} {sampler:?}"), common::asset(scene), settings));
+    for &(scene, max_depth, sampler, light_sampler, _) in FILMS {
+        let settings =
+            Settings { width: 48, height: 48, max_depth, seed: 7, sampler, light_sampler, ..Settings::default() };
+        out.push((format!("{scene} depth {max_depth} {sampler:?} {light_sampler:?}"), common::asset(scene), settings));
     }
-    let settings = Settings {
-        width: 48,
-        height: 48,
-        max_depth: 6,
-        seed: 3,
-        env_color: Some([0.2, 0.25, 0.3]),
-        ..Settings::default()
-    };
-    out.push(("features".into(), features_scene(), settings));
+    for light_sampler in veach::LightSampler::ALL {
+        let settings = Settings {
+            width: 48,
+            height: 48,
+            max_depth: 6,
+            seed: 3,
+            env_color: Some([0.2, 0.25, 0.3]),
+            light_sampler,
+            ..Settings::default()
+        };
+        out.push((format!("features {light_sampler:?}"), features_scene(), settings));
+    }
     out
 }
 
-/// Hash of the features scene's CPU film.
-const FEATURES_CPU: u64 = 0x26c09aa96ba5529d;
+/// Hashes of the features scene's CPU films (power, tree).
+const FEATURES_CPU: [u64; 2] = [0x26c09aa96ba5529d, 0xb710aec0d0f8eea9];
 
 /// GPU films hash the same only on the same driver: (driver string, hashes in `cases()` order).
 const GPU_FILMS: &[(&str, &[u64])] = &[(
@@ -105,7 +112,10 @@ const GPU_FILMS: &[(&str, &[u64])] = &[(
         0xa6a69cfc23b5ecae,
         0xcfe66b0f18714efc,
         0xbf1bac27a228f548,
+        0x6e0ad9ce0bdd72b1,
+        0x7250c4320c173ef7,
         0x0afb3282bdf07e7a,
+        0x36900e92826eef30,
     ],
 )];
 
@@ -134,7 +144,7 @@ fn cpu_films_of_bundled_scenes_are_unchanged() {
         return;
     }
     let mut wrong = Vec::new();
-    let expected = FILMS.iter().map(|f| f.3).chain([FEATURES_CPU]);
+    let expected = FILMS.iter().map(|f| f.4).chain(FEATURES_CPU);
     for ((name, path, settings), expected) in cases().into_iter().zip(expected) {
         let film = common::render(&path, &settings, 4, None);
         let h = fnv(&film.data);

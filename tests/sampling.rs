@@ -11,10 +11,11 @@ use glam::{Vec2, Vec3};
 use serde_json::json;
 use veach::cpu::bvh::{NO_HIT, Ray, intersect_closest};
 use veach::cpu::environment::{environment_pdf, sample_environment};
+use veach::cpu::light_tree::LightContext;
 use veach::cpu::lights::{light_pdf, sample_light};
 use veach::cpu::sampling::{sample_uniform_disk, sample_uniform_triangle};
 use veach::params::Params;
-use veach::{Environment, EnvironmentMap, PackedScene, Settings};
+use veach::{Environment, EnvironmentMap, LightSampler, PackedScene, Settings};
 
 /// A sky brighter towards +Y and in one hot spot: far from uniform in every direction.
 fn sky() -> EnvironmentMap {
@@ -32,7 +33,7 @@ fn sky() -> EnvironmentMap {
 
 /// Three lamps of different size, power and orientation around the origin, disjoint in
 /// direction as seen from it (so the density of a direction is one lamp's), and a sky.
-fn lamps(with_sky: bool) -> (PackedScene, Params) {
+fn lamps(with_sky: bool, light_sampler: LightSampler) -> (PackedScene, Params) {
     const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
     let dir = tempfile::tempdir().unwrap();
     let mut b = GltfBuilder::new(dir.path(), "lamps");
@@ -53,7 +54,9 @@ fn lamps(with_sky: bool) -> (PackedScene, Params) {
     let mut packed = PackedScene::new(&scene);
     let env = if with_sky { Environment::map(sky(), Vec3::ONE) } else { Environment::constant(Vec3::ZERO) };
     packed.set_environment(&env);
-    let params = Params::new(&camera, &Settings::default(), Settings::default().window(), &packed);
+    let settings = Settings { light_sampler, ..Settings::default() };
+    let params = Params::new(&camera, &settings, settings.window(), &packed);
+    assert_eq!(params.light_sampler, light_sampler as u32);
     (packed, params)
 }
 
@@ -61,7 +64,8 @@ fn lamps(with_sky: bool) -> (PackedScene, Params) {
 /// environment's, and the lamp's the ray meets (front faces only), as the integrator's MIS
 /// weights use them. The environment's radiance is blocked where a lamp is, so a sample
 /// reports the density of the technique that drew it; the directions are drawn from the sum.
-fn light_densities(scene: &PackedScene, params: &Params, origin: Vec3, wi: Vec3) -> (f64, f64) {
+fn light_densities(scene: &PackedScene, params: &Params, ctx: &LightContext, wi: Vec3) -> (f64, f64) {
+    let origin = ctx.point;
     let env = if params.env_select > 0.0 { environment_pdf(scene, params, wi) as f64 } else { 0.0 };
     let hit = intersect_closest(scene, &Ray { origin, dir: wi });
     let mut lamp = 0.0;
@@ -70,38 +74,60 @@ fn light_densities(scene: &PackedScene, params: &Params, origin: Vec3, wi: Vec3)
         let n = Vec3::from(tri.e1).cross(Vec3::from(tri.e2)).normalize();
         let cos = -wi.dot(n);
         if tri.light_pdf_area > 0.0 && cos > 0.0 {
-            lamp = light_pdf(params, tri, hit.t * hit.t, cos) as f64;
+            lamp = light_pdf(scene, params, ctx, tri, hit.t * hit.t, cos) as f64;
         }
     }
     (env, lamp)
 }
 
+/// Both light samplers, from points in the open and (tree) at a reflecting surface whose
+/// tangent plane hides the lowest lamp: the tree must give that lamp probability 0, and its
+/// density (tree walk × triangle pdf) must be what MIS evaluates on a hit.
 #[test]
 fn light_sampling_matches_its_pdf() {
-    let cases = [(false, Vec3::ZERO), (true, Vec3::ZERO), (true, Vec3::new(0.3, 0.4, -0.2))];
-    for (with_sky, origin) in cases {
-        let (scene, params) = lamps(with_sky);
+    let free = |p: Vec3| LightContext { point: p, normal: Vec3::Z, reflect_only: false };
+    let mut cases = Vec::new();
+    for sampler in LightSampler::ALL {
+        cases.push((sampler, false, free(Vec3::ZERO)));
+        cases.push((sampler, true, free(Vec3::ZERO)));
+        cases.push((sampler, true, free(Vec3::new(0.3, 0.4, -0.2))));
+    }
+    let floor = LightContext { point: Vec3::new(0.0, -0.25, 0.0), normal: Vec3::Y, reflect_only: true };
+    cases.push((LightSampler::Tree, false, floor));
+    for &(sampler, with_sky, ctx) in &cases {
+        let (scene, params) = lamps(with_sky, sampler);
         assert_eq!(params.light_count, 6, "three quads, two triangles each");
         let mut rng = Lcg(3);
-        let what = format!("sample_light (sky {with_sky}, from {origin})");
+        let what = format!(
+            "sample_light ({} sampler, sky {with_sky}, from {}, normal {})",
+            sampler.label(),
+            ctx.point,
+            ctx.normal
+        );
         let sample = || {
-            let ls = sample_light(&scene, &params, origin, Vec3::new(rng.f(), rng.f(), rng.f()));
+            let ls = sample_light(&scene, &params, &ctx, Vec3::new(rng.f(), rng.f(), rng.f()));
             if ls.pdf <= 0.0 {
                 return None;
             }
             // The pdf a sample reports is its technique's density of its direction.
-            let (env, lamp) = light_densities(&scene, &params, origin, ls.wi);
+            let (env, lamp) = light_densities(&scene, &params, &ctx, ls.wi);
             let close = |d: f64| (d - ls.pdf as f64).abs() <= 2e-3 * d + 1e-6;
             assert!(close(env) || close(lamp), "{what}: pdf {} vs densities {env}, {lamp}", ls.pdf);
+            if ctx.reflect_only {
+                // The lamp in the plane z = −1 lies wholly below the tangent plane.
+                let low_lamp = (ls.point.z + 1.0).abs() < 1e-3 && ls.point.x.abs() < 0.5;
+                assert!(!low_lamp, "{what}: a lamp below the tangent plane was chosen");
+            }
             Some(ls.wi)
         };
         // The lamps' silhouettes cut bins: 64² midpoint cells a bin resolve the slivers.
         let bins = SphereBins { theta: 24, phi: 48, sub: 64, pole_sub: 64 };
         let density = |wi| {
-            let (env, lamp) = light_densities(&scene, &params, origin, wi);
+            let (env, lamp) = light_densities(&scene, &params, &ctx, wi);
             env + lamp
         };
         let r = chi2::sphere(&what, bins, 300_000, sample, density);
+        // The lamps the tree keeps share all of the probability.
         assert!(r.total > 0.99 && r.total < 1.01, "{what}: the density integrates to {}", r.total);
         r.assert_passes(&what, 0.01, cases.len());
     }

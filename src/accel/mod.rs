@@ -9,6 +9,7 @@
 //! ```
 
 pub mod cwbvh;
+pub mod light_bvh;
 pub mod tlas;
 
 pub use cwbvh::{Bvh, CwNode, build, cw_slots};

@@ -6,13 +6,14 @@ use super::camera::camera_sample;
 use super::environment::{environment_pdf, environment_radiance};
 use super::frame::{Frame, frame_from_normal, from_local, to_local};
 use super::instance::world_triangle;
+use super::light_tree::LightContext;
 use super::lights::{LightSample, light_pdf, sample_light, sample_punctual};
 use super::material::{material_at, shading_normal, triangle_uv};
 use super::mis::mis_weight;
 use super::sampler::{Sampler, sample_1d, sample_2d};
 use crate::Strategy;
 use crate::packed::{Material, PackedScene, TRI_MIRRORED};
-use crate::params::Params;
+use crate::params::{LIGHT_SAMPLER_TREE, Params};
 use glam::{UVec2, Vec3};
 
 fn same_side(wi: Vec3, ng: Vec3, wi_local: Vec3) -> bool {
@@ -66,6 +67,8 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
     let mut depth = 0u32;
     let mut prev_pdf = 0.0f32;
     let mut prev_delta = true;
+    // The previous vertex as light selection saw it (for the tree's probability on a hit).
+    let mut prev_ctx = LightContext { point: Vec3::ZERO, normal: Vec3::Z, reflect_only: false };
     loop {
         let hit = intersect_closest(scene, &ray);
         depth += 1;
@@ -101,7 +104,13 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
                 match strategy {
                     Strategy::Light => w = 0.0,
                     Strategy::Bsdf => {}
-                    _ => w = mis_weight(strategy, prev_pdf, light_pdf(params, tri, hit.t * hit.t, cos_hit)),
+                    _ => {
+                        w = mis_weight(
+                            strategy,
+                            prev_pdf,
+                            light_pdf(scene, params, &prev_ctx, tri, hit.t * hit.t, cos_hit),
+                        )
+                    }
                 }
             }
             radiance += beta * emission * w;
@@ -119,21 +128,33 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
         let frame = frame_from_normal(ns);
         let wo = to_local(&frame, -ray.dir);
 
-        if strategy != Strategy::Bsdf && (params.light_count > 0 || params.env_select > 0.0) {
+        let ctx = LightContext { point, normal: ns, reflect_only: m.transmission <= 0.0 };
+        // Next-event estimation: one light sample. With the BSDF strategy alone it still
+        // runs for the tree's Dirac lights, which nothing else can find.
+        let nee_lights =
+            if params.light_sampler == LIGHT_SAMPLER_TREE { params.tree_emitters } else { params.light_count };
+        let nee = if strategy == Strategy::Bsdf {
+            params.light_sampler == LIGHT_SAMPLER_TREE && params.tree_emitters > params.light_count
+        } else {
+            nee_lights > 0 || params.env_select > 0.0
+        };
+        if nee {
             let u0 = sample_1d(sampler);
             let u12 = sample_2d(sampler);
-            let ls = sample_light(scene, params, point, Vec3::new(u0, u12.x, u12.y));
-            let c = connect(scene, m, &frame, wo, eta, point, ng, &ls);
-            if c.max_element() > 0.0 {
-                let w = if strategy == Strategy::Light {
-                    1.0
-                } else {
-                    mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, to_local(&frame, ls.wi), eta))
-                };
-                radiance += beta * c * (w / ls.pdf);
+            let ls = sample_light(scene, params, &ctx, Vec3::new(u0, u12.x, u12.y));
+            if ls.delta || strategy != Strategy::Bsdf {
+                let c = connect(scene, m, &frame, wo, eta, point, ng, &ls);
+                if c.max_element() > 0.0 {
+                    let w = if strategy == Strategy::Light || ls.delta {
+                        1.0
+                    } else {
+                        mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, to_local(&frame, ls.wi), eta))
+                    };
+                    radiance += beta * c * (w / ls.pdf);
+                }
             }
         }
-        if params.punctual_count > 0 {
+        if params.separate_punctuals > 0 {
             let ls = sample_punctual(scene, params, point, sample_1d(sampler));
             radiance += beta * connect(scene, m, &frame, wo, eta, point, ng, &ls) / ls.pdf.max(1e-30);
         }
@@ -154,6 +175,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
         }
         prev_pdf = bs.pdf;
         prev_delta = bs.delta;
+        prev_ctx = ctx;
         ray = Ray { origin: spawn_point(point, ng, wi), dir: wi };
 
         if depth >= params.rr_depth {

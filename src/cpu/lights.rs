@@ -2,10 +2,13 @@
 
 use super::bvh::INF;
 use super::environment::{environment_pdf, environment_radiance, sample_environment};
+use super::light_tree::{LightContext, ONE_MINUS_EPSILON, light_tree_pmf, sample_light_tree};
 use super::material::{material_at, triangle_uv};
 use super::sampling::sample_uniform_triangle;
-use crate::packed::{NO_TEXTURE, PUNCTUAL_POINT, PUNCTUAL_SPOT, PackedScene, Punctual, Triangle};
-use crate::params::Params;
+use crate::packed::{
+    LightEntry, NO_TEXTURE, PUNCTUAL_POINT, PUNCTUAL_SPOT, PackedScene, Punctual, TRI_EMITTER_SHIFT, Triangle,
+};
+use crate::params::{LIGHT_SAMPLER_TREE, Params};
 use glam::{Vec2, Vec3};
 
 #[derive(Clone, Copy, Debug)]
@@ -16,9 +19,15 @@ pub struct LightSample {
     pub normal: Vec3,
     pub radiance: Vec3,
     pub pdf: f32,
+    /// A Dirac light (point, spot): no BSDF sample can find it, so no MIS.
+    pub delta: bool,
 }
 
-pub fn sample_light(scene: &PackedScene, params: &Params, ref_point: Vec3, u: Vec3) -> LightSample {
+/// One light sample for next-event estimation: the environment with probability
+/// `env_select`, else an emitter (by power, or by the light tree from `ctx`), then a point
+/// on it. `pdf` is the solid-angle density (the selection probability for Dirac lights).
+pub fn sample_light(scene: &PackedScene, params: &Params, ctx: &LightContext, u: Vec3) -> LightSample {
+    let ref_point = ctx.point;
     let env_select = params.env_select;
     if u.x < env_select {
         let wi = sample_environment(scene, params, Vec2::new(u.y, u.z));
@@ -29,16 +38,40 @@ pub fn sample_light(scene: &PackedScene, params: &Params, ref_point: Vec3, u: Ve
             normal: -wi,
             radiance: environment_radiance(scene, params, wi),
             pdf: environment_pdf(scene, params, wi),
+            delta: false,
         };
     }
-    let n = params.light_count;
-    let scaled = (u.x - env_select) / (1.0 - env_select) * n as f32;
-    let slot = (scaled as u32).min(n - 1);
-    let mut entry = scene.lights[slot as usize];
-    if scaled - slot as f32 >= entry.prob {
-        entry = scene.lights[entry.alias_slot as usize];
-    }
-    let tri = &scene.triangles[entry.triangle as usize];
+    let u_select = (u.x - env_select) / (1.0 - env_select);
+    let (triangle, select_pmf) = if params.light_sampler == LIGHT_SAMPLER_TREE {
+        let (emitter, pmf) = sample_light_tree(scene, params, ctx, u_select.min(ONE_MINUS_EPSILON));
+        let pmf = (1.0 - env_select) * pmf;
+        if pmf <= 0.0 {
+            return LightSample {
+                wi: ctx.normal,
+                dist: INF,
+                point: ref_point,
+                normal: -ctx.normal,
+                radiance: Vec3::ZERO,
+                pdf: 0.0,
+                delta: false,
+            };
+        }
+        if emitter >= params.light_count {
+            let l = punctual_light(scene, params, params.separate_punctuals + emitter - params.light_count);
+            return punctual_sample(&l, ref_point, pmf);
+        }
+        (light_entry(scene, emitter).triangle, pmf)
+    } else {
+        let n = params.light_count;
+        let scaled = u_select * n as f32;
+        let slot = (scaled as u32).min(n - 1);
+        let mut entry = light_entry(scene, slot);
+        if scaled - slot as f32 >= entry.prob {
+            entry = light_entry(scene, entry.alias_slot);
+        }
+        (entry.triangle, 0.0)
+    };
+    let tri = &scene.triangles[triangle as usize];
     let b = sample_uniform_triangle(Vec2::new(u.y, u.z));
     let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
     let point = Vec3::from(tri.p0) + b.x * e1 + b.y * e2;
@@ -50,18 +83,50 @@ pub fn sample_light(scene: &PackedScene, params: &Params, ref_point: Vec3, u: Ve
     let cos_light = -wi.dot(normal);
     let m = &scene.materials[tri.material as usize];
     let radiance = if m.emissive_texture.layer != NO_TEXTURE {
-        material_at(scene, m, triangle_uv(scene, entry.triangle, b.x, b.y)).emission.into()
+        material_at(scene, m, triangle_uv(scene, triangle, b.x, b.y)).emission.into()
     } else {
         m.emission.into()
     };
+    let mut ls = LightSample { wi, dist, point, normal, radiance, pdf: 0.0, delta: false };
     if cos_light <= 0.0 || dist2 <= 0.0 {
-        return LightSample { wi, dist, point, normal, radiance, pdf: 0.0 };
+        return ls;
     }
-    LightSample { wi, dist, point, normal, radiance, pdf: light_pdf(params, tri, dist2, cos_light) }
+    ls.pdf = if params.light_sampler == LIGHT_SAMPLER_TREE {
+        select_pmf * dist2 / (cos_light * triangle_area(tri))
+    } else {
+        (1.0 - env_select) * tri.light_pdf_area * dist2 / cos_light
+    };
+    ls
 }
 
-pub fn light_pdf(params: &Params, tri: &Triangle, dist2: f32, cos_light: f32) -> f32 {
-    (1.0 - params.env_select) * tri.light_pdf_area * dist2 / cos_light.abs()
+/// Alias-table entry `slot` (its row of the `lights` buffer).
+pub fn light_entry(scene: &PackedScene, slot: u32) -> LightEntry {
+    bytemuck::cast(scene.light_rows[slot as usize])
+}
+
+pub fn triangle_area(tri: &Triangle) -> f32 {
+    0.5 * Vec3::from(tri.e1).cross(Vec3::from(tri.e2)).length()
+}
+
+/// Solid-angle density with which `sample_light` from `ctx` finds the point of `tri` that a
+/// ray reached at distance² `dist2` with cosine `cos_light` to the light's normal.
+pub fn light_pdf(
+    scene: &PackedScene,
+    params: &Params,
+    ctx: &LightContext,
+    tri: &Triangle,
+    dist2: f32,
+    cos_light: f32,
+) -> f32 {
+    if params.light_sampler != LIGHT_SAMPLER_TREE {
+        return (1.0 - params.env_select) * tri.light_pdf_area * dist2 / cos_light.abs();
+    }
+    let emitter = tri.flags >> TRI_EMITTER_SHIFT;
+    if emitter == 0 {
+        return 0.0;
+    }
+    let pmf = (1.0 - params.env_select) * light_tree_pmf(scene, params, ctx, emitter - 1);
+    pmf * dist2 / (cos_light.abs() * triangle_area(tri))
 }
 
 pub fn punctual_light(scene: &PackedScene, params: &Params, index: u32) -> Punctual {
@@ -69,15 +134,29 @@ pub fn punctual_light(scene: &PackedScene, params: &Params, index: u32) -> Punct
     bytemuck::cast_slice::<[f32; 4], Punctual>(&scene.light_data[base..base + 4])[0]
 }
 
+/// One of the first `separate_punctuals` punctual lights, chosen uniformly.
 pub fn sample_punctual(scene: &PackedScene, params: &Params, ref_point: Vec3, u: f32) -> LightSample {
-    let n = params.punctual_count;
+    let n = params.separate_punctuals;
     let index = ((u * n as f32) as u32).min(n - 1);
-    let l = punctual_light(scene, params, index);
-    let pdf = 1.0 / n as f32;
+    punctual_sample(&punctual_light(scene, params, index), ref_point, 1.0 / n as f32)
+}
+
+/// Light from punctual light `l` at `ref_point`, chosen with probability `pdf`: `radiance` is
+/// the irradiance factor I/r² (point, spot) or E (directional), glTF's window for `range`,
+/// spot cone falloff t² with t = clamp((cos θ − cos outer) / (cos inner − cos outer)).
+pub fn punctual_sample(l: &Punctual, ref_point: Vec3, pdf: f32) -> LightSample {
     let (position, direction, intensity) = (Vec3::from(l.position), Vec3::from(l.direction), Vec3::from(l.intensity));
     if l.kind != PUNCTUAL_POINT && l.kind != PUNCTUAL_SPOT {
         let wi = -direction;
-        return LightSample { wi, dist: INF, point: ref_point, normal: direction, radiance: intensity, pdf };
+        return LightSample {
+            wi,
+            dist: INF,
+            point: ref_point,
+            normal: direction,
+            radiance: intensity,
+            pdf,
+            delta: true,
+        };
     }
     let to_light = position - ref_point;
     let dist2 = to_light.dot(to_light);
@@ -94,8 +173,8 @@ pub fn sample_punctual(scene: &PackedScene, params: &Params, ref_point: Vec3, u:
         let t = ((cos_axis - l.cos_outer) / (l.cos_inner - l.cos_outer).max(1e-4)).clamp(0.0, 1.0);
         scale *= t * t;
     }
-    if dist2 <= 0.0 || scale <= 0.0 {
-        return LightSample { wi, dist, point: position, normal: -wi, radiance: Vec3::ZERO, pdf: 0.0 };
+    if dist2 <= 0.0 || scale <= 0.0 || pdf <= 0.0 {
+        return LightSample { wi, dist, point: position, normal: -wi, radiance: Vec3::ZERO, pdf: 0.0, delta: true };
     }
-    LightSample { wi, dist, point: position, normal: -wi, radiance: intensity * scale, pdf }
+    LightSample { wi, dist, point: position, normal: -wi, radiance: intensity * scale, pdf, delta: true }
 }

@@ -10,6 +10,7 @@ pub mod environment;
 pub mod frame;
 pub mod instance;
 pub mod integrator;
+pub mod light_tree;
 pub mod lights;
 pub mod material;
 pub mod microfacet;

@@ -65,7 +65,7 @@ impl GpuRenderer {
             triangles,
             attributes,
             materials: storage("materials", bytemuck::cast_slice(&scene.materials))?,
-            lights: storage("lights", bytemuck::cast_slice(&scene.lights))?,
+            lights: storage("lights", bytemuck::cast_slice(&scene.light_rows))?,
             light_data: storage("light data", bytemuck::cast_slice(&scene.light_data))?,
             textures,
         };

@@ -20,6 +20,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("microfacet.wgsl", include_str!("../../shaders/microfacet.wgsl")),
     ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
     ("environment.wgsl", include_str!("../../shaders/environment.wgsl")),
+    ("light_tree.wgsl", include_str!("../../shaders/light_tree.wgsl")),
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
     ("film.wgsl", include_str!("../../shaders/film.wgsl")),
     ("integrator.wgsl", include_str!("../../shaders/integrator.wgsl")),

@@ -29,6 +29,17 @@ pub const TRI_ALPHA: u32 = 4;
 pub const TRI_TANGENT_SIGN_SHIFT: u32 = 3;
 /// Set on a triangle moved to world space by a mirroring instance (winding reversed).
 pub const TRI_MIRRORED: u32 = 64;
+/// Bits 8–31: the triangle's emitter index + 1 in the light tree (0: not an emitter).
+pub const TRI_EMITTER_SHIFT: u32 = 8;
+/// Emitters the triangle flags can name.
+pub const MAX_EMITTERS: usize = (1 << (32 - TRI_EMITTER_SHIFT)) - 1;
+
+/// Rows (vec4<u32>) per light-tree node in the `lights` buffer.
+pub const LIGHT_NODE_ROWS: u32 = 3;
+/// A light-tree node's index word: set on leaves (the rest is the emitter).
+pub const LIGHT_LEAF: u32 = 1 << 31;
+/// A light-tree node's flags word: some emitter below emits from both faces.
+pub const LIGHT_TWO_SIDED: u32 = 1;
 
 /// Per-triangle vertex attributes: octahedron-encoded normals and tangents
 /// (`pack2x16snorm`) and TEXCOORD_0, one of each per vertex.

@@ -8,6 +8,7 @@ mod features;
 mod geometry;
 mod instances;
 pub mod layout;
+mod light_tree;
 mod lights;
 mod materials;
 mod octahedral;
@@ -27,6 +28,15 @@ use environment::pack_environment;
 use geometry::{pack_attributes, pack_triangle};
 use glam::Vec3;
 use instances::build_instances;
+use light_tree::{pack_light_tree, punctual_bounds, triangle_bounds};
+
+/// (nodes, depth, build seconds, bytes) of the packed light tree over `emitters`: `veach
+/// bench`'s scale test.
+pub fn pack_light_tree_for_bench(emitters: &[crate::accel::light_bvh::LightBounds]) -> (usize, u32, f64, usize) {
+    let t0 = std::time::Instant::now();
+    let t = pack_light_tree(emitters);
+    (t.nodes, t.depth, t0.elapsed().as_secs_f64(), t.rows.len() * 16)
+}
 use lights::{build_alias_table, pack_punctual};
 use textures::pack_textures;
 
@@ -44,6 +54,19 @@ pub struct PackedScene {
     pub attributes: Vec<Attributes>,
     pub materials: Vec<Material>,
     pub lights: Vec<LightEntry>,
+    /// The `lights` buffer: the alias table (one row per entry, `LightEntry` as u32 bits),
+    /// then from `tree_base` the light tree's nodes (`LIGHT_NODE_ROWS` rows each) and from
+    /// `trail_base` its emitters' trails, four per row. At least one row.
+    pub light_rows: Vec<[u32; 4]>,
+    /// Emitters in the light tree (0: no tree): the alias table's triangles, then the point
+    /// and spot lights (the punctual lights after the first `directional_count`).
+    pub tree_emitters: u32,
+    pub tree_base: u32,
+    pub trail_base: u32,
+    pub directional_count: u32,
+    pub light_tree_nodes: usize,
+    pub light_tree_depth: u32,
+    pub light_tree_seconds: f64,
     /// Original scene index of each packed triangle.
     pub order: Vec<u32>,
     pub bvh_build_seconds: f64,
@@ -114,6 +137,43 @@ impl PackedScene {
 
         let mut triangles: Vec<Triangle> =
             ordered.iter().zip(&light_pdf).map(|(t, &pdf)| pack_triangle(scene, t, pdf)).collect();
+
+        // Punctual lights: directional ones first (they stay outside the light tree).
+        let mut punctuals: Vec<Punctual> = scene.punctual_lights.iter().map(pack_punctual).collect();
+        punctuals.sort_by_key(|l| l.kind != PUNCTUAL_DIRECTIONAL);
+        let directional_count = punctuals.iter().filter(|l| l.kind == PUNCTUAL_DIRECTIONAL).count() as u32;
+        let mut emitters: Vec<_> = lights
+            .iter()
+            .map(|l| {
+                let t = ordered[l.triangle as usize];
+                triangle_bounds(t.positions, luminance(scene.materials[t.material as usize].emission))
+            })
+            .collect();
+        emitters.extend(
+            punctuals[directional_count as usize..].iter().map(|l| punctual_bounds(l, luminance(l.intensity.into()))),
+        );
+        // (A black light keeps its place with no power: it is never chosen.)
+        let tree = if !emitters.is_empty() && emitters.len() <= MAX_EMITTERS {
+            for (i, l) in lights.iter().enumerate() {
+                triangles[l.triangle as usize].flags |= (i as u32 + 1) << TRI_EMITTER_SHIFT;
+            }
+            Some(pack_light_tree(&emitters))
+        } else {
+            // More emitters than the triangle flags can name: only the power sampler.
+            None
+        };
+        let mut light_rows: Vec<[u32; 4]> = bytemuck::cast_slice(&lights).to_vec();
+        let tree_base = light_rows.len() as u32;
+        let (tree_emitters, trail_base, light_tree_nodes, light_tree_depth, light_tree_seconds) = match tree {
+            Some(t) => {
+                light_rows.extend_from_slice(&t.rows);
+                (emitters.len() as u32, tree_base + t.trail_offset, t.nodes, t.depth, t.build_seconds)
+            }
+            None => (0, tree_base, 0, 0, 0.0),
+        };
+        if light_rows.is_empty() {
+            light_rows.push([0; 4]);
+        }
         if triangles.is_empty() {
             // No triangle is referenced (the empty BVH's root has no children), but a storage
             // binding needs at least one element.
@@ -127,7 +187,6 @@ impl PackedScene {
             build_instances(scene, bvh.nodes, bvh.depth, &mut triangles, &mut attributes, bvh.build_seconds)
         };
         let nodes_len = nodes.len();
-        let punctuals: Vec<Punctual> = scene.punctual_lights.iter().map(pack_punctual).collect();
         let (texels, texture_size, texture_layers) = pack_textures(&scene.textures);
         let bounds = scene.bounds();
         let extent = if bounds.is_empty() { 1.0 } else { bounds.diagonal().length() };
@@ -143,6 +202,14 @@ impl PackedScene {
             attributes,
             materials,
             lights,
+            light_rows,
+            tree_emitters,
+            tree_base,
+            trail_base,
+            directional_count,
+            light_tree_nodes,
+            light_tree_depth,
+            light_tree_seconds,
             order: bvh.order,
             bvh_build_seconds: build_seconds,
             bvh_nodes,

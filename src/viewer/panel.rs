@@ -2,8 +2,8 @@
 
 use super::Viewer;
 use super::orbit::Orbit;
-use crate::Strategy;
 use crate::tonemap::Tonemap;
+use crate::{LightSampler, Strategy};
 use eframe::egui;
 use std::path::PathBuf;
 
@@ -25,7 +25,7 @@ impl Viewer {
         ui.separator();
         ui.checkbox(&mut self.paused, "pause");
         ui.add(egui::Slider::new(&mut self.target_spp, 1..=65536).logarithmic(true).text("target spp"));
-        let before = (self.settings.strategy, self.settings.max_depth, self.env_strength);
+        let before = (self.settings.strategy, self.settings.light_sampler, self.settings.max_depth, self.env_strength);
         egui::ComboBox::from_label("strategy").selected_text(format!("{:?}", self.settings.strategy)).show_ui(
             ui,
             |ui| {
@@ -34,9 +34,18 @@ impl Viewer {
                 }
             },
         );
+        egui::ComboBox::from_label("light sampler").selected_text(self.settings.light_sampler.label()).show_ui(
+            ui,
+            |ui| {
+                for s in LightSampler::ALL {
+                    ui.selectable_value(&mut self.settings.light_sampler, s, s.label());
+                }
+            },
+        );
         ui.add(egui::Slider::new(&mut self.settings.max_depth, 0..=32).text("max depth (0 = ∞)"));
         ui.add(egui::Slider::new(&mut self.env_strength, 0.0..=10.0).text("environment"));
-        changed |= before != (self.settings.strategy, self.settings.max_depth, self.env_strength);
+        changed |=
+            before != (self.settings.strategy, self.settings.light_sampler, self.settings.max_depth, self.env_strength);
         let max_aperture = MAX_APERTURE_EXTENTS * self.extent;
         changed |=
             ui.add(egui::Slider::new(&mut self.settings.aperture, 0.0..=max_aperture).text("aperture (DOF)")).changed();

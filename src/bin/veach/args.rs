@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 use glam::Vec3;
 use std::path::PathBuf;
 use veach::tonemap::Tonemap;
-use veach::{Backend, SamplerKind, Strategy, Tile};
+use veach::{Backend, LightSampler, SamplerKind, Strategy, Tile};
 
 #[derive(Parser)]
 #[command(
@@ -130,6 +130,9 @@ pub struct BenchArgs {
     /// Spheres per side in the generated large scene (~16k triangles each; 4 = ~262k).
     #[arg(long, default_value_t = 4)]
     pub large_grid: u32,
+    /// Emitters of the generated light-tree build (no rendering; 1 M by default).
+    #[arg(long, default_value_t = 1_000_000)]
+    pub tree_emitters: usize,
     /// Also write the results as JSON to this file.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -187,6 +190,10 @@ pub struct LookArgs {
     /// Distance in focus (default with --aperture: what the image centre sees).
     #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub focus_distance: Option<f32>,
+    /// How next-event estimation picks a light: tree (the light BVH: by importance to the
+    /// shading point) or power (by power alone, the former sampler, kept for comparison).
+    #[arg(long, value_enum, default_value_t = LightSampler::Tree)]
+    pub light_sampler: LightSampler,
 }
 
 #[derive(clap::Args)]
@@ -322,6 +329,7 @@ impl LookArgs {
         settings.env_strength = self.env_strength;
         settings.aperture = self.aperture;
         settings.focus_distance = self.focus_distance;
+        settings.light_sampler = self.light_sampler;
     }
 
     /// Whether any of these flags was given (they conflict with --resume).
@@ -331,6 +339,7 @@ impl LookArgs {
             || self.env.is_some()
             || self.env_strength != 1.0
             || self.aperture != 0.0
+            || self.light_sampler != LightSampler::Tree
             || self.focus_distance.is_some()
     }
 }

@@ -14,6 +14,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
         spp: args.spp,
         max_depth: args.max_depth,
         large_grid: args.large_grid,
+        tree_emitters: args.tree_emitters,
     };
     let report = veach::bench::run(&opts, &backends, &mut |line| eprintln!("veach bench: {line}"))?;
     print!("{}", veach::bench::format_report(&report));

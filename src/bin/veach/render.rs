@@ -17,7 +17,8 @@ fn job_of(args: &RenderArgs) -> Result<(Job, Option<veach::Film>), Error> {
     if let Some(path) = &args.resume {
         if args.look.any() {
             return Err(Error::Input(
-                "--resume continues the saved render: camera, environment and lens flags cannot change it".into(),
+                "--resume continues the saved render: camera, environment, lens and light-sampler flags cannot change it"
+                    .into(),
             ));
         }
         let (film, job) = veach::output::read_film(path)?;
@@ -64,6 +65,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     }
     let packed = veach::PackedScene::new(&loaded.scene);
     let (bvh_nodes, bvh_depth, bvh_seconds) = (packed.bvh_nodes, packed.bvh_depth, packed.bvh_build_seconds);
+    let light_tree = (packed.light_tree_nodes, packed.light_tree_depth, packed.light_tree_seconds);
     let mut renderer = crate::open_renderer(packed, &loaded.camera, &job.settings, args.backend)?;
     let mut done = 0u32;
     if let Some(film) = resumed {
@@ -156,6 +158,10 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             "seed": s.seed,
             "strategy": s.strategy,
             "sampler": s.sampler,
+            "light_sampler": s.light_sampler,
+            "light_tree_nodes": light_tree.0,
+            "light_tree_depth": light_tree.1,
+            "light_tree_build_seconds": light_tree.2,
             "adapter": renderer.adapter_name(),
             "backend": format!("{:?}", renderer.backend()).to_lowercase(),
             "seconds_total": t0.elapsed().as_secs_f64(),

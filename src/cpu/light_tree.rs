@@ -1,0 +1,209 @@
+//! Twin of `shaders/light_tree.wgsl`: walking the light BVH (`accel/light_bvh.rs`) from the
+//! root with one random number, and the exact probability of choosing an emitter.
+
+use super::lights::light_entry;
+use crate::packed::{LIGHT_LEAF, LIGHT_NODE_ROWS, LIGHT_TWO_SIDED, PackedScene, oct_decode};
+use crate::params::Params;
+use glam::{Vec2, Vec3};
+
+/// What light selection knows of the shading point. A BSDF hit on an emitter recomputes the
+/// selection probability with the context of the vertex the ray left, bit for bit the one
+/// next-event estimation used there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightContext {
+    pub point: Vec3,
+    /// Shading normal facing the outgoing direction.
+    pub normal: Vec3,
+    /// The BSDF only reflects: emitters below the tangent plane cannot contribute.
+    pub reflect_only: bool,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct LightNode {
+    pub lo: Vec3,
+    pub phi: f32,
+    pub hi: Vec3,
+    pub axis: Vec3,
+    pub cos_o: f32,
+    pub cos_e: f32,
+    /// Child 1 (interior) or the emitter (leaf).
+    pub index: u32,
+    pub leaf: bool,
+    pub two_sided: bool,
+}
+
+/// The largest f32 below 1: rescaled numbers stay in [0, 1).
+pub const ONE_MINUS_EPSILON: f32 = 0.99999994;
+
+pub fn load_light_node(scene: &PackedScene, params: &Params, node: u32) -> LightNode {
+    let base = (params.tree_base + LIGHT_NODE_ROWS * node) as usize;
+    let [r0, r1, r2] = [scene.light_rows[base], scene.light_rows[base + 1], scene.light_rows[base + 2]];
+    let f = f32::from_bits;
+    LightNode {
+        lo: Vec3::new(f(r0[0]), f(r0[1]), f(r0[2])),
+        phi: f(r0[3]),
+        hi: Vec3::new(f(r1[0]), f(r1[1]), f(r1[2])),
+        axis: oct_decode(r1[3]),
+        cos_o: f(r2[0]),
+        cos_e: f(r2[1]),
+        index: r2[2] & !LIGHT_LEAF,
+        leaf: r2[2] & LIGHT_LEAF != 0,
+        two_sided: r2[3] & LIGHT_TWO_SIDED != 0,
+    }
+}
+
+fn safe_sqrt(x: f32) -> f32 {
+    x.max(0.0).sqrt()
+}
+
+/// cos(max(0, θa − θb)) from the sines and cosines.
+fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
+    if cos_a > cos_b { 1.0 } else { cos_a * cos_b + sin_a * sin_b }
+}
+
+/// sin(max(0, θa − θb)).
+fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
+    if cos_a > cos_b { 0.0 } else { sin_a * cos_b - cos_a * sin_b }
+}
+
+/// Two estimates, up to a constant, of the irradiance the node's emitters give the shading
+/// point: phi · cos θ' / d² times the bound of the receiver's cosine (pbrt-v4's light-bounds
+/// importance), θ' the smallest angle between the emitters' cone and the direction to the
+/// point, with d the distance to the box's centre (x: the far estimate, clamped below by the
+/// bounding sphere's radius) and to its nearest point (y: the near one, clamped by half that
+/// radius). The walk mixes the two (as Cycles mixes its minimum and maximum importance): the
+/// centre alone starves a bright emitter at the near edge of a large box. Both are zero when
+/// no emitter faces the point or (reflection-only BSDFs) the node lies below the tangent plane.
+pub fn node_importance(ctx: &LightContext, node: &LightNode) -> Vec2 {
+    if node.phi <= 0.0 {
+        return Vec2::ZERO;
+    }
+    let p = ctx.point;
+    let pc = 0.5 * (node.lo + node.hi);
+    let half = 0.5 * (node.hi - node.lo);
+    if ctx.reflect_only && (pc - p).dot(ctx.normal) + half.dot(ctx.normal.abs()) <= 0.0 {
+        return Vec2::ZERO;
+    }
+    let r2 = half.dot(half);
+    let to_p = p - pc;
+    let dist2 = to_p.dot(to_p);
+    let outside = p - p.clamp(node.lo, node.hi);
+    let d2 = Vec2::new(dist2.max(r2), outside.dot(outside).max(0.25 * r2)).max(Vec2::splat(1e-20));
+    if dist2 <= r2 {
+        // Inside the bounding sphere every direction is possible.
+        return node.phi / d2;
+    }
+    let wi = to_p * (1.0 / dist2.sqrt());
+    let mut cos_w = node.axis.dot(wi);
+    if node.two_sided {
+        cos_w = cos_w.abs();
+    }
+    let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
+    let sin2_b = r2 / dist2;
+    let cos_b = safe_sqrt(1.0 - sin2_b);
+    let sin_b = sin2_b.sqrt();
+    let sin_o = safe_sqrt(1.0 - node.cos_o * node.cos_o);
+    let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, node.cos_o);
+    let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, node.cos_o);
+    let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
+    if cos_p <= node.cos_e {
+        return Vec2::ZERO;
+    }
+    let cos_i = wi.dot(ctx.normal).abs();
+    let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
+    let cos_pi = cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
+    (node.phi * cos_p * cos_pi / d2).max(Vec2::ZERO)
+}
+
+/// A child's importances in the walk: a leaf holding a one-sided triangle is also tested
+/// against the triangle's own plane, so that a point behind it (even inside its bounding
+/// sphere, where the cone test cannot tell) gets probability 0.
+pub fn child_importance(scene: &PackedScene, params: &Params, ctx: &LightContext, node: &LightNode) -> Vec2 {
+    let importance = node_importance(ctx, node);
+    if importance.x > 0.0 && node.leaf && !node.two_sided && node.index < params.light_count {
+        let tri = &scene.triangles[light_entry(scene, node.index).triangle as usize];
+        let n = Vec3::from(tri.e1).cross(Vec3::from(tri.e2));
+        if n.dot(ctx.point - Vec3::from(tri.p0)) <= 0.0 {
+            return Vec2::ZERO;
+        }
+    }
+    importance
+}
+
+/// The probability of taking the child with importances `i` when its sibling's sum with it
+/// to `total`: the mean of the far and the near estimates' shares (0 when `total` is 0).
+pub fn child_share(i: Vec2, total: Vec2) -> f32 {
+    0.5 * (i.x / total.x + i.y / total.y)
+}
+
+/// Chooses an emitter: at each node a child by its share, `u` rescaled into the chosen
+/// interval. Returns (emitter, probability); probability 0: nothing to choose (every emitter
+/// of the subtree reached provably contributes nothing).
+pub fn sample_light_tree(scene: &PackedScene, params: &Params, ctx: &LightContext, u: f32) -> (u32, f32) {
+    let mut node = load_light_node(scene, params, 0);
+    if node.leaf {
+        return (node.index, if child_importance(scene, params, ctx, &node).x > 0.0 { 1.0 } else { 0.0 });
+    }
+    let mut at = 0u32;
+    let mut u = u;
+    let mut pmf = 1.0f32;
+    loop {
+        let c0 = load_light_node(scene, params, at + 1);
+        let c1 = load_light_node(scene, params, node.index);
+        let (i0, i1) = (child_importance(scene, params, ctx, &c0), child_importance(scene, params, ctx, &c1));
+        let total = i0 + i1;
+        if total.x.is_nan() || total.x <= 0.0 {
+            return (0, 0.0);
+        }
+        let p0 = child_share(i0, total);
+        if u < p0 {
+            u = (u / p0).min(ONE_MINUS_EPSILON);
+            pmf *= p0;
+            at += 1;
+            node = c0;
+        } else {
+            u = ((u - p0) / (1.0 - p0)).min(ONE_MINUS_EPSILON);
+            pmf *= child_share(i1, total);
+            at = node.index;
+            node = c1;
+        }
+        if node.leaf {
+            return (node.index, pmf);
+        }
+    }
+}
+
+/// The probability that `sample_light_tree` chooses `emitter` from `ctx`: the walk down its
+/// trail, multiplying the same shares in the same order.
+pub fn light_tree_pmf(scene: &PackedScene, params: &Params, ctx: &LightContext, emitter: u32) -> f32 {
+    let mut node = load_light_node(scene, params, 0);
+    if node.leaf {
+        return if child_importance(scene, params, ctx, &node).x > 0.0 { 1.0 } else { 0.0 };
+    }
+    let row = scene.light_rows[(params.trail_base + emitter / 4) as usize];
+    let mut trail = row[(emitter % 4) as usize];
+    let mut at = 0u32;
+    let mut pmf = 1.0f32;
+    loop {
+        let c0 = load_light_node(scene, params, at + 1);
+        let c1 = load_light_node(scene, params, node.index);
+        let (i0, i1) = (child_importance(scene, params, ctx, &c0), child_importance(scene, params, ctx, &c1));
+        let total = i0 + i1;
+        if total.x.is_nan() || total.x <= 0.0 {
+            return 0.0;
+        }
+        if trail & 1 == 0 {
+            pmf *= child_share(i0, total);
+            at += 1;
+            node = c0;
+        } else {
+            pmf *= child_share(i1, total);
+            at = node.index;
+            node = c1;
+        }
+        trail >>= 1;
+        if node.leaf {
+            return pmf;
+        }
+    }
+}
