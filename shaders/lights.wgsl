@@ -11,6 +11,7 @@
 #include "environment.wgsl"
 #include "material.wgsl"
 #include "light_tree.wgsl"
+#include "spherical_triangle.wgsl"
 
 struct LightSample {
     // Unit direction from the shading point to the light.
@@ -31,6 +32,39 @@ struct LightSample {
 fn light_entry(slot: u32) -> LightEntry {
     let r = lights[slot];
     return LightEntry(r.x, r.y, bitcast<f32>(r.z), bitcast<f32>(r.w));
+}
+
+// Emitted radiance at barycentrics `b` of triangle `index`.
+fn emitted(tri: Triangle, index: u32, b: vec2<f32>) -> vec3<f32> {
+    if (TEXTURES && materials[tri.material].emissive_texture.layer != NO_TEXTURE) {
+        return material_at(materials[tri.material], triangle_uv(index, b.x, b.y)).emission;
+    }
+    return materials[tri.material].emission;
+}
+
+// Barycentrics (of vertices 1 and 2) of the point `v` (relative to vertex 0) in the plane of
+// edges `e1`, `e2`, clamped onto the triangle.
+fn barycentrics(v: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>) -> vec2<f32> {
+    let d00 = dot(e1, e1);
+    let d01 = dot(e1, e2);
+    let d11 = dot(e2, e2);
+    let d20 = dot(v, e1);
+    let d21 = dot(v, e2);
+    let denom = d00 * d11 - d01 * d01;
+    let b1 = clamp((d11 * d20 - d01 * d21) / denom, 0.0, 1.0);
+    let b2 = clamp((d00 * d21 - d01 * d20) / denom, 0.0, 1.0);
+    let s = b1 + b2;
+    return select(vec2<f32>(b1, b2), vec2<f32>(b1 / s, b2 / s), s > 1.0);
+}
+
+// The solid angle of `tri` from `p` when the tree's light sampling samples it by solid
+// angle (p in front, the angle within [SOLID_ANGLE_MIN, SOLID_ANGLE_MAX]), else 0 (by area).
+fn triangle_solid_angle(p: vec3<f32>, tri: Triangle) -> f32 {
+    if (dot(cross(tri.e1, tri.e2), p - tri.p0) <= 0.0) {
+        return 0.0;
+    }
+    let omega = spherical_triangle_area(p, tri.p0, tri.p0 + tri.e1, tri.p0 + tri.e2);
+    return select(0.0, omega, omega >= SOLID_ANGLE_MIN && omega <= SOLID_ANGLE_MAX);
 }
 
 fn triangle_area(tri: Triangle) -> f32 {
@@ -69,23 +103,43 @@ fn sample_light(ctx: LightContext, u: vec3<f32>) -> LightSample {
         triangle = entry.triangle;
     }
     let tri = load_triangle(triangle);
+    let normal = normalize(cross(tri.e1, tri.e2));
+    let tree = params.light_sampler == LIGHT_SAMPLER_TREE;
+    var omega = 0.0;
+    if (tree) {
+        omega = triangle_solid_angle(ref_point, tri);
+    }
+    if (omega > 0.0) {
+        // Uniform in the solid angle: the point is where the sampled direction meets the plane.
+        let s = sample_spherical_triangle(ref_point, tri.p0, tri.p0 + tri.e1, tri.p0 + tri.e2, u.y, u.z);
+        if (!s.ok) {
+            return LightSample(normal, INF, ref_point, normal, vec3<f32>(0.0), 0.0, false);
+        }
+        let t = dot(tri.p0 - ref_point, normal) / dot(s.w, normal);
+        let bs = barycentrics(ref_point + t * s.w - tri.p0, tri.e1, tri.e2);
+        let point_s = tri.p0 + bs.x * tri.e1 + bs.y * tri.e2;
+        let to_point = point_s - ref_point;
+        let dist_s = length(to_point);
+        let wi_s = to_point / dist_s;
+        var pdf_s = 0.0;
+        if (t > 0.0 && dist_s > 0.0) {
+            pdf_s = select_pmf / omega;
+        }
+        return LightSample(wi_s, dist_s, point_s, normal, emitted(tri, triangle, bs), pdf_s, false);
+    }
     let b = sample_uniform_triangle(u.yz);
     let point = tri.p0 + b.x * tri.e1 + b.y * tri.e2;
-    let normal = normalize(cross(tri.e1, tri.e2));
     let to_light = point - ref_point;
     let dist2 = dot(to_light, to_light);
     let dist = sqrt(dist2);
     let wi = to_light / dist;
     let cos_light = -dot(wi, normal);
-    var radiance = materials[tri.material].emission;
-    if (TEXTURES && materials[tri.material].emissive_texture.layer != NO_TEXTURE) {
-        radiance = material_at(materials[tri.material], triangle_uv(triangle, b.x, b.y)).emission;
-    }
+    let radiance = emitted(tri, triangle, b);
     if (cos_light <= 0.0 || dist2 <= 0.0) {
         return LightSample(wi, dist, point, normal, radiance, 0.0, false);
     }
     var pdf = (1.0 - env_select) * tri.light_pdf_area * dist2 / cos_light;
-    if (params.light_sampler == LIGHT_SAMPLER_TREE) {
+    if (tree) {
         pdf = select_pmf * dist2 / (cos_light * triangle_area(tri));
     }
     return LightSample(wi, dist, point, normal, radiance, pdf, false);
@@ -102,6 +156,10 @@ fn light_pdf(ctx: LightContext, tri: Triangle, dist2: f32, cos_light: f32) -> f3
         return 0.0;
     }
     let pmf = (1.0 - params.env_select) * light_tree_pmf(ctx, emitter - 1u);
+    let omega = triangle_solid_angle(ctx.point, tri);
+    if (omega > 0.0) {
+        return pmf / omega;
+    }
     return pmf * dist2 / (abs(cos_light) * triangle_area(tri));
 }
 

@@ -251,6 +251,9 @@ fn shared_constants_have_the_same_values() {
         ("INF", veach::cpu::bvh::INF as f64),
         ("DELTA_ALPHA", veach::cpu::bsdf::DELTA_ALPHA as f64),
         ("UNIFORM_SPHERE_PDF", veach::cpu::sampling::UNIFORM_SPHERE_PDF as f64),
+        ("SOLID_ANGLE_MIN", veach::cpu::spherical_triangle::SOLID_ANGLE_MIN as f64),
+        ("SOLID_ANGLE_MAX", veach::cpu::spherical_triangle::SOLID_ANGLE_MAX as f64),
+        ("ONE_MINUS_EPSILON", veach::cpu::light_tree::ONE_MINUS_EPSILON as f64),
     ];
     let mut wrong = Vec::new();
     for (name, value) in rust {

@@ -5,6 +5,7 @@ use super::environment::{environment_pdf, environment_radiance, sample_environme
 use super::light_tree::{LightContext, ONE_MINUS_EPSILON, light_tree_pmf, sample_light_tree};
 use super::material::{material_at, triangle_uv};
 use super::sampling::sample_uniform_triangle;
+use super::spherical_triangle::{SOLID_ANGLE_MAX, SOLID_ANGLE_MIN, sample_spherical_triangle, spherical_triangle_area};
 use crate::packed::{
     LightEntry, NO_TEXTURE, PUNCTUAL_POINT, PUNCTUAL_SPOT, PackedScene, Punctual, TRI_EMITTER_SHIFT, Triangle,
 };
@@ -72,31 +73,85 @@ pub fn sample_light(scene: &PackedScene, params: &Params, ctx: &LightContext, u:
         (entry.triangle, 0.0)
     };
     let tri = &scene.triangles[triangle as usize];
-    let b = sample_uniform_triangle(Vec2::new(u.y, u.z));
-    let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
-    let point = Vec3::from(tri.p0) + b.x * e1 + b.y * e2;
+    let (p0, e1, e2) = (Vec3::from(tri.p0), Vec3::from(tri.e1), Vec3::from(tri.e2));
     let normal = e1.cross(e2).normalize();
+    let tree = params.light_sampler == LIGHT_SAMPLER_TREE;
+    let omega = if tree { triangle_solid_angle(ref_point, tri) } else { 0.0 };
+    if omega > 0.0 {
+        // Uniform in the solid angle: the point is where the sampled direction meets the plane.
+        let Some(w) = sample_spherical_triangle(ref_point, p0, p0 + e1, p0 + e2, u.y, u.z) else {
+            return LightSample {
+                wi: normal,
+                dist: INF,
+                point: ref_point,
+                normal,
+                radiance: Vec3::ZERO,
+                pdf: 0.0,
+                delta: false,
+            };
+        };
+        let t = (p0 - ref_point).dot(normal) / w.dot(normal);
+        let b = barycentrics(ref_point + t * w - p0, e1, e2);
+        let point = p0 + b.x * e1 + b.y * e2;
+        let to_light = point - ref_point;
+        let dist = to_light.length();
+        let wi = to_light / dist;
+        let radiance = emitted(scene, tri, triangle, b);
+        let pdf = if t > 0.0 && dist > 0.0 { select_pmf / omega } else { 0.0 };
+        return LightSample { wi, dist, point, normal, radiance, pdf, delta: false };
+    }
+    let b = sample_uniform_triangle(Vec2::new(u.y, u.z));
+    let point = p0 + b.x * e1 + b.y * e2;
     let to_light = point - ref_point;
     let dist2 = to_light.dot(to_light);
     let dist = dist2.sqrt();
     let wi = to_light / dist;
     let cos_light = -wi.dot(normal);
-    let m = &scene.materials[tri.material as usize];
-    let radiance = if m.emissive_texture.layer != NO_TEXTURE {
-        material_at(scene, m, triangle_uv(scene, triangle, b.x, b.y)).emission.into()
-    } else {
-        m.emission.into()
-    };
+    let radiance = emitted(scene, tri, triangle, b);
     let mut ls = LightSample { wi, dist, point, normal, radiance, pdf: 0.0, delta: false };
     if cos_light <= 0.0 || dist2 <= 0.0 {
         return ls;
     }
-    ls.pdf = if params.light_sampler == LIGHT_SAMPLER_TREE {
+    ls.pdf = if tree {
         select_pmf * dist2 / (cos_light * triangle_area(tri))
     } else {
         (1.0 - env_select) * tri.light_pdf_area * dist2 / cos_light
     };
     ls
+}
+
+/// Emitted radiance at barycentrics `b` of triangle `index`.
+fn emitted(scene: &PackedScene, tri: &Triangle, index: u32, b: Vec2) -> Vec3 {
+    let m = &scene.materials[tri.material as usize];
+    if m.emissive_texture.layer != NO_TEXTURE {
+        material_at(scene, m, triangle_uv(scene, index, b.x, b.y)).emission.into()
+    } else {
+        m.emission.into()
+    }
+}
+
+/// Barycentrics (of vertices 1 and 2) of the point `v` (relative to vertex 0) in the plane
+/// of edges `e1`, `e2`, clamped onto the triangle.
+pub fn barycentrics(v: Vec3, e1: Vec3, e2: Vec3) -> Vec2 {
+    let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (d20, d21) = (v.dot(e1), v.dot(e2));
+    let denom = d00 * d11 - d01 * d01;
+    let b1 = ((d11 * d20 - d01 * d21) / denom).clamp(0.0, 1.0);
+    let b2 = ((d00 * d21 - d01 * d20) / denom).clamp(0.0, 1.0);
+    let s = b1 + b2;
+    if s > 1.0 { Vec2::new(b1 / s, b2 / s) } else { Vec2::new(b1, b2) }
+}
+
+/// The solid angle of `tri` from `p` when the tree's light sampling samples it by solid
+/// angle (p in front of it, the angle within [SOLID_ANGLE_MIN, SOLID_ANGLE_MAX]), else 0
+/// (sampled by area).
+pub fn triangle_solid_angle(p: Vec3, tri: &Triangle) -> f32 {
+    let (p0, e1, e2) = (Vec3::from(tri.p0), Vec3::from(tri.e1), Vec3::from(tri.e2));
+    if e1.cross(e2).dot(p - p0) <= 0.0 {
+        return 0.0;
+    }
+    let omega = spherical_triangle_area(p, p0, p0 + e1, p0 + e2);
+    if (SOLID_ANGLE_MIN..=SOLID_ANGLE_MAX).contains(&omega) { omega } else { 0.0 }
 }
 
 /// Alias-table entry `slot` (its row of the `lights` buffer).
@@ -126,6 +181,10 @@ pub fn light_pdf(
         return 0.0;
     }
     let pmf = (1.0 - params.env_select) * light_tree_pmf(scene, params, ctx, emitter - 1);
+    let omega = triangle_solid_angle(ctx.point, tri);
+    if omega > 0.0 {
+        return pmf / omega;
+    }
     pmf * dist2 / (cos_light.abs() * triangle_area(tri))
 }
 

@@ -19,6 +19,7 @@ pub mod renderer;
 pub mod rng;
 pub mod sampler;
 pub mod sampling;
+pub mod spherical_triangle;
 pub mod texture;
 
 pub use integrator::render_sample;

@@ -20,6 +20,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("microfacet.wgsl", include_str!("../../shaders/microfacet.wgsl")),
     ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
     ("environment.wgsl", include_str!("../../shaders/environment.wgsl")),
+    ("spherical_triangle.wgsl", include_str!("../../shaders/spherical_triangle.wgsl")),
     ("light_tree.wgsl", include_str!("../../shaders/light_tree.wgsl")),
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
     ("film.wgsl", include_str!("../../shaders/film.wgsl")),

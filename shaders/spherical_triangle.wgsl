@@ -1,0 +1,88 @@
+// Sampling a triangle uniformly in the solid angle it subtends (Arvo 1995, in the form
+// pbrt-v4 uses), for the light tree's triangles; below SOLID_ANGLE_MIN and above
+// SOLID_ANGLE_MAX the light sampler samples by area instead, and the pdf of a BSDF hit takes
+// the same branch through `spherical_triangle_area`. Twin: src/cpu/spherical_triangle.rs.
+#include "common.wgsl"
+
+const SOLID_ANGLE_MIN: f32 = 1e-3;
+const SOLID_ANGLE_MAX: f32 = 6.22;
+
+fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
+    let len2 = dot(v, v);
+    return select(vec3<f32>(0.0), v * (1.0 / sqrt(len2)), len2 > 0.0);
+}
+
+// The solid angle of the triangle seen from `p` (van Oosterom & Strackee).
+fn spherical_triangle_area(p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> f32 {
+    let a = normalize_or_zero(v0 - p);
+    let b = normalize_or_zero(v1 - p);
+    let c = normalize_or_zero(v2 - p);
+    return abs(2.0 * atan2(dot(a, cross(b, c)), 1.0 + dot(a, b) + dot(a, c) + dot(b, c)));
+}
+
+// The angle between unit vectors, accurate near 0 and π.
+fn angle_between(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    if (dot(a, b) < 0.0) {
+        return PI - 2.0 * asin(min(length(a + b) * 0.5, 1.0));
+    }
+    return 2.0 * asin(min(length(b - a) * 0.5, 1.0));
+}
+
+fn orthonormal_part(v: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
+    return normalize_or_zero(v - w * dot(v, w));
+}
+
+struct SphericalSample {
+    w: vec3<f32>,
+    ok: bool,
+}
+
+// A direction from `p` uniform over the triangle's solid angle, or ok = false when the
+// triangle is degenerate from `p`.
+fn sample_spherical_triangle(
+    p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, u0: f32, u1: f32
+) -> SphericalSample {
+    let fail = SphericalSample(vec3<f32>(0.0), false);
+    let a = normalize_or_zero(v0 - p);
+    let b = normalize_or_zero(v1 - p);
+    let c = normalize_or_zero(v2 - p);
+    var n_ab = cross(a, b);
+    var n_bc = cross(b, c);
+    var n_ca = cross(c, a);
+    if (dot(n_ab, n_ab) == 0.0 || dot(n_bc, n_bc) == 0.0 || dot(n_ca, n_ca) == 0.0) {
+        return fail;
+    }
+    n_ab = normalize(n_ab);
+    n_bc = normalize(n_bc);
+    n_ca = normalize(n_ca);
+    let alpha = angle_between(n_ab, -n_ca);
+    let beta = angle_between(n_bc, -n_ab);
+    let gamma = angle_between(n_ca, -n_bc);
+    let area = alpha + beta + gamma - PI;
+    if (!(area > 0.0)) {
+        return fail;
+    }
+    // sin and cos of A' − α, which lies in [−π, π] where WGSL bounds their error.
+    let d = u0 * area - alpha;
+    let sin_phi = -sin(d);
+    let cos_phi = -cos(d);
+    let sin_alpha = sin(alpha);
+    let cos_alpha = cos(alpha);
+    let k1 = cos_phi + cos_alpha;
+    let k2 = sin_phi - sin_alpha * dot(a, b);
+    let num = k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha;
+    let cos_bp = clamp(num / ((k2 * sin_phi + k1 * cos_phi) * sin_alpha), -1.0, 1.0);
+    if (cos_bp != cos_bp) {
+        return fail;
+    }
+    let sin_bp = sqrt(max(1.0 - cos_bp * cos_bp, 0.0));
+    let cp = cos_bp * a + sin_bp * orthonormal_part(c, a);
+    let cp_b = cp - b;
+    let cos_theta = 1.0 - u1 * 0.5 * dot(cp_b, cp_b);
+    let sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
+    let w = cos_theta * b + sin_theta * orthonormal_part(cp, b);
+    if (!is_finite_vec3(w)) {
+        return fail;
+    }
+    return SphericalSample(normalize(w), true);
+}

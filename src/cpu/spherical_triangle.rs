@@ -1,0 +1,76 @@
+//! Twin of `shaders/spherical_triangle.wgsl`: sampling a triangle uniformly in the solid
+//! angle it subtends (Arvo 1995, in the form pbrt-v4 uses), for the light tree's triangles.
+//! Below `SOLID_ANGLE_MIN` (tiny or distant triangles, where area sampling is as good and
+//! the spherical formulas lose precision) and above `SOLID_ANGLE_MAX` (nearly a hemisphere)
+//! the light sampler samples by area instead; sampling and the pdf of a BSDF hit take the
+//! same branch through `spherical_triangle_area`.
+
+use glam::Vec3;
+
+pub const SOLID_ANGLE_MIN: f32 = 1e-3;
+pub const SOLID_ANGLE_MAX: f32 = 6.22;
+
+/// The solid angle of the triangle (v0, v1, v2) seen from `p` (van Oosterom & Strackee).
+pub fn spherical_triangle_area(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> f32 {
+    let a = (v0 - p).normalize_or_zero();
+    let b = (v1 - p).normalize_or_zero();
+    let c = (v2 - p).normalize_or_zero();
+    (2.0 * a.dot(b.cross(c)).atan2(1.0 + a.dot(b) + a.dot(c) + b.dot(c))).abs()
+}
+
+/// The angle between unit vectors, accurate near 0 and π.
+fn angle_between(a: Vec3, b: Vec3) -> f32 {
+    if a.dot(b) < 0.0 {
+        std::f32::consts::PI - 2.0 * ((a + b).length() * 0.5).min(1.0).asin()
+    } else {
+        2.0 * ((b - a).length() * 0.5).min(1.0).asin()
+    }
+}
+
+/// `v` made orthogonal to unit `w`, normalised.
+fn orthonormal_part(v: Vec3, w: Vec3) -> Vec3 {
+    (v - w * v.dot(w)).normalize_or_zero()
+}
+
+/// A direction from `p` uniformly distributed over the triangle's solid angle (its density
+/// is 1 / `spherical_triangle_area`), or None when the triangle is degenerate from `p`.
+pub fn sample_spherical_triangle(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3, u0: f32, u1: f32) -> Option<Vec3> {
+    let a = (v0 - p).normalize_or_zero();
+    let b = (v1 - p).normalize_or_zero();
+    let c = (v2 - p).normalize_or_zero();
+    let (n_ab, n_bc, n_ca) = (a.cross(b), b.cross(c), c.cross(a));
+    if n_ab.length_squared() == 0.0 || n_bc.length_squared() == 0.0 || n_ca.length_squared() == 0.0 {
+        return None;
+    }
+    let (n_ab, n_bc, n_ca) = (n_ab.normalize(), n_bc.normalize(), n_ca.normalize());
+    let alpha = angle_between(n_ab, -n_ca);
+    let beta = angle_between(n_bc, -n_ab);
+    let gamma = angle_between(n_ca, -n_bc);
+    let area = alpha + beta + gamma - std::f32::consts::PI;
+    if area.is_nan() || area <= 0.0 {
+        return None;
+    }
+    // The sub-triangle of area A' = u0·A fixes c' on the arc a→c; sin and cos are taken of
+    // A' − α, which lies in [−π, π] (WGSL's sin and cos are only bounded there).
+    let ap = u0 * area;
+    let (sin_d, cos_d) = (ap - alpha).sin_cos();
+    let (sin_phi, cos_phi) = (-sin_d, -cos_d);
+    let (sin_alpha, cos_alpha) = alpha.sin_cos();
+    let k1 = cos_phi + cos_alpha;
+    let k2 = sin_phi - sin_alpha * a.dot(b);
+    let cos_bp = ((k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha) / ((k2 * sin_phi + k1 * cos_phi) * sin_alpha))
+        .clamp(-1.0, 1.0);
+    if cos_bp.is_nan() {
+        return None;
+    }
+    let sin_bp = (1.0 - cos_bp * cos_bp).max(0.0).sqrt();
+    let cp = cos_bp * a + sin_bp * orthonormal_part(c, a);
+    // u1 picks the point on the arc b→c'; 1 − x·y = ½|x − y|² keeps the small differences.
+    let cos_theta = 1.0 - u1 * 0.5 * (cp - b).length_squared();
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let w = cos_theta * b + sin_theta * orthonormal_part(cp, b);
+    if !w.is_finite() {
+        return None;
+    }
+    Some(w.normalize())
+}
