@@ -20,6 +20,31 @@ fn spherical_triangle_area(p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<
     return abs(2.0 * atan2(dot(a, cross(b, c)), 1.0 + dot(a, b) + dot(a, c) + dot(b, c)));
 }
 
+// sin x for |x| ≤ π by our own polynomial (Taylor to x¹³ on [−π/2, π/2]), the same
+// operations as the Rust twin: WGSL bounds its sin and cos only to 2⁻¹¹ absolute.
+fn bounded_sin(x: f32) -> f32 {
+    var y = x;
+    if (x > 0.5 * PI) {
+        y = PI - x;
+    } else if (x < -0.5 * PI) {
+        y = -PI - x;
+    }
+    let y2 = y * y;
+    var p = 1.0 / 6227020800.0;
+    p = -1.0 / 39916800.0 + y2 * p;
+    p = 1.0 / 362880.0 + y2 * p;
+    p = -1.0 / 5040.0 + y2 * p;
+    p = 1.0 / 120.0 + y2 * p;
+    p = -1.0 / 6.0 + y2 * p;
+    return y * (1.0 + y2 * p);
+}
+
+// cos x for |x| ≤ π, as sin(x + π/2) brought back into [−π, π].
+fn bounded_cos(x: f32) -> f32 {
+    let y = x + 0.5 * PI;
+    return bounded_sin(select(y, y - 2.0 * PI, y > PI));
+}
+
 // The angle between unit vectors, accurate near 0 and π.
 fn angle_between(a: vec3<f32>, b: vec3<f32>) -> f32 {
     if (dot(a, b) < 0.0) {
@@ -64,10 +89,10 @@ fn sample_spherical_triangle(
     }
     // sin and cos of A' − α, which lies in [−π, π] where WGSL bounds their error.
     let d = u0 * area - alpha;
-    let sin_phi = -sin(d);
-    let cos_phi = -cos(d);
-    let sin_alpha = sin(alpha);
-    let cos_alpha = cos(alpha);
+    let sin_phi = -bounded_sin(d);
+    let cos_phi = -bounded_cos(d);
+    let sin_alpha = bounded_sin(alpha);
+    let cos_alpha = bounded_cos(alpha);
     let k1 = cos_phi + cos_alpha;
     let k2 = sin_phi - sin_alpha * dot(a, b);
     let num = k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha;

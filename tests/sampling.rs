@@ -206,21 +206,6 @@ fn the_harness_detects_a_wrong_pdf() {
     assert!(r.p < 1e-6, "a skewed sampler passed: {r:?}");
 }
 
-/// Does the ray from `p` along `w` cross the triangle? (Möller–Trumbore, both faces.)
-fn crosses(p: Vec3, w: Vec3, v: [Vec3; 3]) -> bool {
-    let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
-    let q = w.cross(e2);
-    let det = e1.dot(q);
-    if det.abs() < 1e-12 {
-        return false;
-    }
-    let s = p - v[0];
-    let a = s.dot(q) / det;
-    let r = s.cross(e1);
-    let b = w.dot(r) / det;
-    a >= 0.0 && b >= 0.0 && a + b <= 1.0 && e2.dot(r) / det > 0.0
-}
-
 /// Spherical-triangle sampling is uniform over the triangle's solid angle, from near and far,
 /// for a sliver and for a triangle covering most of a hemisphere; no sample fails. Tested in
 /// the triangle's barycentric square, where slivers are as well resolved as the rest: the

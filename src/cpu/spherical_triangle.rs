@@ -18,6 +18,36 @@ pub fn spherical_triangle_area(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> f32 {
     (2.0 * a.dot(b.cross(c)).atan2(1.0 + a.dot(b) + a.dot(c) + b.dot(c))).abs()
 }
 
+/// sin x for |x| ≤ π by a polynomial of our own (Taylor to x¹³ on [−π/2, π/2], error below
+/// 1e-9 before rounding), the same operations in both twins: WGSL bounds its own sin and cos
+/// only to 2⁻¹¹ absolute, and lavapipe's differ from libm's enough to move samples.
+pub fn bounded_sin(x: f32) -> f32 {
+    let half_pi = std::f32::consts::FRAC_PI_2;
+    let pi = std::f32::consts::PI;
+    let y = if x > half_pi {
+        pi - x
+    } else if x < -half_pi {
+        -pi - x
+    } else {
+        x
+    };
+    let y2 = y * y;
+    let p = 1.0 / 6227020800.0;
+    let p = -1.0 / 39916800.0 + y2 * p;
+    let p = 1.0 / 362880.0 + y2 * p;
+    let p = -1.0 / 5040.0 + y2 * p;
+    let p = 1.0 / 120.0 + y2 * p;
+    let p = -1.0 / 6.0 + y2 * p;
+    y * (1.0 + y2 * p)
+}
+
+/// cos x for |x| ≤ π, as sin(x + π/2) brought back into [−π, π].
+pub fn bounded_cos(x: f32) -> f32 {
+    let pi = std::f32::consts::PI;
+    let y = x + std::f32::consts::FRAC_PI_2;
+    bounded_sin(if y > pi { y - 2.0 * pi } else { y })
+}
+
 /// The angle between unit vectors, accurate near 0 and π.
 fn angle_between(a: Vec3, b: Vec3) -> f32 {
     if a.dot(b) < 0.0 {
@@ -53,9 +83,9 @@ pub fn sample_spherical_triangle(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3, u0: f32,
     // The sub-triangle of area A' = u0·A fixes c' on the arc a→c; sin and cos are taken of
     // A' − α, which lies in [−π, π] (WGSL's sin and cos are only bounded there).
     let ap = u0 * area;
-    let (sin_d, cos_d) = (ap - alpha).sin_cos();
-    let (sin_phi, cos_phi) = (-sin_d, -cos_d);
-    let (sin_alpha, cos_alpha) = alpha.sin_cos();
+    let d = ap - alpha;
+    let (sin_phi, cos_phi) = (-bounded_sin(d), -bounded_cos(d));
+    let (sin_alpha, cos_alpha) = (bounded_sin(alpha), bounded_cos(alpha));
     let k1 = cos_phi + cos_alpha;
     let k2 = sin_phi - sin_alpha * a.dot(b);
     let cos_bp = ((k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha) / ((k2 * sin_phi + k1 * cos_phi) * sin_alpha))

@@ -136,6 +136,10 @@ pub struct BenchArgs {
     /// Also write the results as JSON to this file.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Write the generated scenes (spheres-large.glb, many-lights.gltf) into this directory
+    /// and exit, to render them with `veach render`.
+    #[arg(long)]
+    pub write_scenes: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]

@@ -99,8 +99,11 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             if let Some(r) = &reference
                 && (p.done.is_power_of_two() || p.finished())
             {
-                let rmse = veach::metrics::rmse(&renderer.film()?, r);
-                convergence.push(serde_json::json!({"spp": p.done, "seconds": p.seconds, "rmse": rmse}));
+                let film = renderer.film()?;
+                let (rmse, clamped) = (veach::metrics::rmse(&film, r), veach::metrics::rmse_clamped(&film, r));
+                convergence.push(
+                    serde_json::json!({"spp": p.done, "seconds": p.seconds, "rmse": rmse, "rmse_clamped": clamped}),
+                );
             }
             bar.set_position(p.done as u64);
             let rate = (p.done - first) as f64 * pixels / p.seconds.max(1e-9);
