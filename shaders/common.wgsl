@@ -62,7 +62,7 @@ const LIGHT_SAMPLER_TREE: u32 = 1u;
 // Light-tree nodes: rows per node, the leaf bit of the index word, the two-sided flag.
 const LIGHT_NODE_ROWS: u32 = 3u;
 const LIGHT_LEAF: u32 = 0x80000000u;
-const LIGHT_TWO_SIDED: u32 = 1u;
+const LIGHT_TWO_SIDED: u32 = 0x40000000u;
 
 // Per-triangle vertex attributes: octahedral normals and tangents, TEXCOORD_0.
 struct Attributes {

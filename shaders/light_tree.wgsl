@@ -21,6 +21,7 @@ struct LightNode {
     hi: vec3<f32>,
     axis: vec3<f32>,
     cos_o: f32,
+    sin_o: f32,
     cos_e: f32,
     // Child 1 (interior) or the emitter (leaf).
     index: u32,
@@ -38,8 +39,8 @@ fn load_light_node(node: u32) -> LightNode {
     let r2 = lights[base + 2u];
     return LightNode(
         bitcast<vec3<f32>>(r0.xyz), bitcast<f32>(r0.w), bitcast<vec3<f32>>(r1.xyz), oct_decode(r1.w),
-        bitcast<f32>(r2.x), bitcast<f32>(r2.y), r2.z & ~LIGHT_LEAF, (r2.z & LIGHT_LEAF) != 0u,
-        (r2.w & LIGHT_TWO_SIDED) != 0u
+        bitcast<f32>(r2.x), bitcast<f32>(r2.w), bitcast<f32>(r2.y), r2.z & ~(LIGHT_LEAF | LIGHT_TWO_SIDED),
+        (r2.z & LIGHT_LEAF) != 0u, (r2.z & LIGHT_TWO_SIDED) != 0u
     );
 }
 
@@ -88,9 +89,8 @@ fn node_importance(ctx: LightContext, node: LightNode) -> vec2<f32> {
     let sin2_b = r2 / dist2;
     let cos_b = safe_sqrt(1.0 - sin2_b);
     let sin_b = sqrt(sin2_b);
-    let sin_o = safe_sqrt(1.0 - node.cos_o * node.cos_o);
-    let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, node.cos_o);
-    let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, node.cos_o);
+    let cos_x = cos_sub_clamped(sin_w, cos_w, node.sin_o, node.cos_o);
+    let sin_x = sin_sub_clamped(sin_w, cos_w, node.sin_o, node.cos_o);
     let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
     if (cos_p <= node.cos_e) {
         return vec2<f32>(0.0);

@@ -77,10 +77,11 @@ fn cone_union(wa: Vec3, cos_a: f32, wb: Vec3, cos_b: f32) -> (Vec3, f32) {
     // Rotate wa towards wb by θ_o − θ_a about their common normal (Rodrigues).
     // Opposite axes: any common normal will do.
     let k = wa.cross(wb).try_normalize().unwrap_or_else(|| wa.any_orthonormal_vector());
-    let r = theta_o - theta_a;
-    let w = wa * r.cos() + k.cross(wa) * r.sin() + k * k.dot(wa) * (1.0 - r.cos());
+    let (sin_r, cos_r) = (theta_o - theta_a).sin_cos();
+    let w = wa * cos_r + k.cross(wa) * sin_r + k * k.dot(wa) * (1.0 - cos_r);
     // Rounded towards the wider cone, so it still holds both.
-    (w.normalize().as_vec3(), widen(theta_o.cos(), 1e-6))
+    let theta = theta_o + 1e-6;
+    (w.normalize().as_vec3(), if theta >= pi { -1.0 } else { theta.cos() as f32 })
 }
 
 /// The angle between unit vectors, accurate near 0 and π.
@@ -116,149 +117,254 @@ pub struct LightBvh {
     pub build_seconds: f64,
 }
 
-/// SAOH cost of a side (pbrt-v4's `EvaluateCost`): power × the solid angle its cone and
-/// spread reach (M_Ω) × the box's surface area, scaled for thin boxes along the axis.
-fn cost(b: &LightBounds, k_r: f32) -> f64 {
-    let cos_o = (b.cos_o as f64).clamp(-1.0, 1.0);
-    let theta_o = cos_o.acos();
-    let theta_e = (b.cos_e as f64).clamp(-1.0, 1.0).acos();
-    let pi = std::f64::consts::PI;
-    let theta_w = (theta_o + theta_e).min(pi);
-    let sin_o = (1.0 - cos_o * cos_o).max(0.0).sqrt();
-    let m_omega = 2.0 * pi * (1.0 - cos_o)
-        + pi / 2.0 * (2.0 * theta_w * sin_o - (theta_o - 2.0 * theta_w).cos() - 2.0 * theta_o * sin_o + cos_o);
-    let d = (b.hi - b.lo).as_dvec3();
-    let area = 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
-    b.phi as f64 * m_omega * k_r as f64 * area.max(1e-30)
-}
-
 fn ceil_log2(n: usize) -> u32 {
     if n <= 1 { 0 } else { usize::BITS - (n - 1).leading_zeros() }
 }
+
+/// An emitter during the build: items are partitioned in place, so each subtree's emitters
+/// are contiguous (sequential memory, and disjoint slices for building subtrees in parallel).
+#[derive(Clone, Copy)]
+struct Item {
+    bounds: LightBounds,
+    centroid: Vec3,
+    id: u32,
+    trail: u32,
+}
+
+/// Subtrees larger than this are built in parallel with their sibling.
+const PARALLEL_ITEMS: usize = 1024;
+
+/// Nodes of at most this many emitters consider one split axis.
+const SMALL_NODE: usize = 16;
+
+/// Nodes of at most this many emitters are split at the median: the SAOH's bookkeeping
+/// costs more than its choice among so few gains.
+const MEDIAN_NODE: usize = 4;
+
+/// Nodes of more emitters than this rank their splits on a sample of about this many.
+const SAMPLED_EMITTERS: usize = 4096;
 
 /// Builds the tree over `emitters` (every phi > 0). Depth stays ≤ MAX_LIGHT_DEPTH: a split
 /// is kept only if both sides could still be split evenly within it, else the node is
 /// split at the median.
 pub fn build_light_bvh(emitters: &[LightBounds]) -> LightBvh {
     let t0 = std::time::Instant::now();
-    let mut bvh = LightBvh {
-        nodes: Vec::with_capacity(2 * emitters.len()),
-        trails: vec![0; emitters.len()],
-        depth: 0,
-        build_seconds: 0.0,
-    };
+    let mut bvh = LightBvh { nodes: Vec::new(), trails: vec![0; emitters.len()], depth: 0, build_seconds: 0.0 };
     if emitters.is_empty() {
         return bvh;
     }
     assert!(ceil_log2(emitters.len()) <= MAX_LIGHT_DEPTH, "too many emitters for the light BVH");
-    let mut ids: Vec<u32> = (0..emitters.len() as u32).collect();
-    build_node(emitters, &mut ids, 0, 0, &mut bvh);
+    let mut items: Vec<Item> = emitters
+        .iter()
+        .enumerate()
+        .map(|(id, b)| Item { bounds: *b, centroid: b.centroid(), id: id as u32, trail: 0 })
+        .collect();
+    // A subtree over m emitters has exactly 2m − 1 nodes, so every subtree's place in the
+    // depth-first array is known before it is built: siblings fill disjoint slices.
+    let placeholder = LightNode { bounds: emitters[0], index: 0, leaf: true };
+    bvh.nodes = vec![placeholder; 2 * emitters.len() - 1];
+    let (_, depth) = build_node(&mut items, 0, 0, &mut bvh.nodes, 0);
+    for it in &items {
+        bvh.trails[it.id as usize] = it.trail;
+    }
+    bvh.depth = depth;
     bvh.build_seconds = t0.elapsed().as_secs_f64();
     bvh
 }
 
-fn build_node(e: &[LightBounds], ids: &mut [u32], depth: u32, trail: u32, bvh: &mut LightBvh) -> LightBounds {
-    let at = bvh.nodes.len();
-    if ids.len() == 1 {
-        let b = e[ids[0] as usize];
-        bvh.nodes.push(LightNode { bounds: b, index: ids[0], leaf: true });
-        bvh.trails[ids[0] as usize] = trail;
-        bvh.depth = bvh.depth.max(depth);
-        return b;
+/// Builds the subtree over `items` into `out` (2 · items − 1 nodes, the first at index
+/// `base`); returns its bounds and deepest leaf.
+fn build_node(items: &mut [Item], depth: u32, trail: u32, out: &mut [LightNode], base: u32) -> (LightBounds, u32) {
+    if items.len() == 1 {
+        items[0].trail = trail;
+        out[0] = LightNode { bounds: items[0].bounds, index: items[0].id, leaf: true };
+        return (items[0].bounds, depth);
     }
-    let mid = split(e, ids, depth);
-    bvh.nodes.push(LightNode { bounds: e[ids[0] as usize], index: 0, leaf: false });
-    let (left, right) = ids.split_at_mut(mid);
-    let b0 = build_node(e, left, depth + 1, trail, bvh);
-    let child1 = bvh.nodes.len() as u32;
-    let b1 = build_node(e, right, depth + 1, trail | (1 << depth), bvh);
+    let mid = split(items, depth);
+    let (left, right) = items.split_at_mut(mid);
+    let (head, rest) = out.split_at_mut(1);
+    let (out0, out1) = rest.split_at_mut(2 * mid - 1);
+    let child1 = base + 2 * mid as u32;
+    let trail1 = trail | (1 << depth);
+    let ((b0, d0), (b1, d1)) = if left.len().min(right.len()) > PARALLEL_ITEMS {
+        rayon::join(
+            || build_node(left, depth + 1, trail, out0, base + 1),
+            || build_node(right, depth + 1, trail1, out1, child1),
+        )
+    } else {
+        (build_node(left, depth + 1, trail, out0, base + 1), build_node(right, depth + 1, trail1, out1, child1))
+    };
     let b = b0.union(&b1);
-    bvh.nodes[at] = LightNode { bounds: b, index: child1, leaf: false };
-    b
+    head[0] = LightNode { bounds: b, index: child1, leaf: false };
+    (b, d0.max(d1))
 }
 
-/// Reorders `ids` and returns the size of the first side.
-fn split(e: &[LightBounds], ids: &mut [u32], depth: u32) -> usize {
-    let n = ids.len();
+/// What the SAOH needs of a bucket or of a side: box, power and an orientation cone that is
+/// a bound but not the tightest (the nodes' own cones are `LightBounds::union`'s).
+#[derive(Clone, Copy)]
+struct Guide {
+    lo: Vec3,
+    hi: Vec3,
+    phi: f32,
+    axis: Vec3,
+    cos_o: f32,
+    cos_e: f32,
+}
+
+/// cos(a + b) from cos a and cos b (angles in [0, π]); −1 once the sum passes π.
+fn cos_sum(ca: f32, cb: f32) -> f32 {
+    let (sa, sb) = ((1.0 - ca * ca).max(0.0).sqrt(), (1.0 - cb * cb).max(0.0).sqrt());
+    // sin(a + b) < 0 with cos(a + b) < 0: past π.
+    if ca * sb + sa * cb < 0.0 && ca * cb - sa * sb < 0.0 { -1.0 } else { (ca * cb - sa * sb).max(-1.0) }
+}
+
+impl Guide {
+    /// The cone of `b` re-centred on `w`.
+    fn around(w: Vec3, b: &LightBounds) -> Guide {
+        let cos_d = w.dot(b.axis).clamp(-1.0, 1.0);
+        // One-sided triangles (θ_o = 0) are most emitters: skip the trigonometry.
+        let cos_o = if b.cos_o >= 1.0 {
+            cos_d
+        } else if b.cos_o <= -1.0 {
+            -1.0
+        } else {
+            cos_sum(cos_d, b.cos_o)
+        };
+        Guide { lo: b.lo, hi: b.hi, phi: b.phi, axis: w, cos_o, cos_e: b.cos_e }
+    }
+
+    /// Both: around the power-weighted mean axis, wide enough for each cone.
+    fn union(&self, b: &Guide) -> Guide {
+        let w = (self.axis * self.phi + b.axis * b.phi).try_normalize().unwrap_or(self.axis);
+        let cone = |g: &Guide| if g.cos_o <= -1.0 { -1.0 } else { cos_sum(w.dot(g.axis).clamp(-1.0, 1.0), g.cos_o) };
+        Guide {
+            lo: self.lo.min(b.lo),
+            hi: self.hi.max(b.hi),
+            phi: self.phi + b.phi,
+            axis: w,
+            cos_o: cone(self).min(cone(b)),
+            cos_e: self.cos_e.min(b.cos_e),
+        }
+    }
+
+    /// SAOH cost of a side (pbrt-v4's `EvaluateCost`): power × the solid angle its cone and
+    /// spread reach (M_Ω) × the box's surface area, scaled for thin boxes along the axis.
+    /// Without transcendental calls but one arccosine polynomial: it only ranks splits.
+    fn cost(&self, k_r: f32) -> f32 {
+        use std::f32::consts::PI;
+        let (cos_o, cos_e) = (self.cos_o.clamp(-1.0, 1.0), self.cos_e.clamp(-1.0, 1.0));
+        let sin_o = (1.0 - cos_o * cos_o).max(0.0).sqrt();
+        let sin_e = (1.0 - cos_e * cos_e).max(0.0).sqrt();
+        let (theta_o, theta_e) = (acos_approx(cos_o), acos_approx(cos_e));
+        // θ_w = min(θ_o + θ_e, π); cos(θ_o − 2θ_w) by the angle-sum identities.
+        let (span, cos_term) = if theta_o + theta_e >= PI {
+            (PI - theta_o, cos_o)
+        } else {
+            let (cos_2e, sin_2e) = (2.0 * cos_e * cos_e - 1.0, 2.0 * sin_e * cos_e);
+            (theta_e, cos_o * cos_2e - sin_o * sin_2e)
+        };
+        let m_omega = 2.0 * PI * (1.0 - cos_o) + PI / 2.0 * (2.0 * span * sin_o - cos_term + cos_o);
+        let d = self.hi - self.lo;
+        let area = 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
+        self.phi * m_omega * k_r * area.max(1e-30)
+    }
+}
+
+/// arccos to ~7e-5 rad (Abramowitz & Stegun 4.4.45), for ranking splits.
+fn acos_approx(x: f32) -> f32 {
+    let a = x.abs();
+    let r = (1.0 - a).max(0.0).sqrt() * (1.570_728_8 + a * (-0.212_114_4 + a * (0.074_261_0 + a * -0.018_729_3)));
+    if x >= 0.0 { r } else { std::f32::consts::PI - r }
+}
+
+/// Reorders `items` and returns the size of the first side.
+fn split(items: &mut [Item], depth: u32) -> usize {
+    let n = items.len();
     let (mut clo, mut chi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     let (mut blo, mut bhi) = (clo, chi);
-    for &i in ids.iter() {
-        let b = &e[i as usize];
-        clo = clo.min(b.centroid());
-        chi = chi.max(b.centroid());
-        blo = blo.min(b.lo);
-        bhi = bhi.max(b.hi);
+    for it in items.iter() {
+        clo = clo.min(it.centroid);
+        chi = chi.max(it.centroid);
+        blo = blo.min(it.bounds.lo);
+        bhi = bhi.max(it.bounds.hi);
     }
     let diag = bhi - blo;
+    if n <= MEDIAN_NODE {
+        return median_split(items, (chi - clo).max_position());
+    }
     let fits = |a: usize| depth + 1 + ceil_log2(a.max(n - a)) <= MAX_LIGHT_DEPTH;
-    let mut best: Option<(f64, usize, usize)> = None; // (cost, axis, first bucket of side 1)
-    for axis in 0..3 {
-        let (lo, hi) = (clo[axis], chi[axis]);
-        if hi <= lo {
+    let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, first bucket of side 1)
+    // Bucket statistics for the three axes in two passes over the items (the upper levels
+    // do not fit in cache: passes, not arithmetic, are the cost).
+    let scale = Vec3::select((chi - clo).cmpgt(Vec3::ZERO), BUCKETS as f32 / (chi - clo), Vec3::ZERO);
+    let bucket_of =
+        |c: Vec3, axis: usize| (((c[axis] - clo[axis]) * scale[axis]) as i32).clamp(0, BUCKETS as i32 - 1) as usize;
+    // Small nodes (most of them) try only the axis of widest spread: three times cheaper,
+    // and their splits matter little.
+    let widest = (chi - clo).max_position();
+    let axes: &[usize] = if n <= SMALL_NODE { std::slice::from_ref(&widest) } else { &[0, 1, 2] };
+    // Large nodes rank their splits on an even sample of their emitters.
+    let stride = n.div_ceil(SAMPLED_EMITTERS);
+    let m = n.div_ceil(stride);
+    let mut counts = [[0usize; BUCKETS]; 3];
+    let mut sum_axis = [[Vec3::ZERO; BUCKETS]; 3];
+    for it in items.iter().step_by(stride) {
+        let w = it.bounds.axis * it.bounds.phi;
+        for &axis in axes {
+            let k = bucket_of(it.centroid, axis);
+            counts[axis][k] += 1;
+            sum_axis[axis][k] += w;
+        }
+    }
+    // A bucket's cone: around the power-weighted mean of its axes, wide enough for each
+    // (cheaper than pairwise unions, and still a bound).
+    let mean = sum_axis.map(|a| a.map(|s| s.try_normalize().unwrap_or(Vec3::Z)));
+    let empty = Guide { lo: Vec3::INFINITY, hi: Vec3::NEG_INFINITY, phi: 0.0, axis: Vec3::Z, cos_o: 1.0, cos_e: 1.0 };
+    let mut guides = [[empty; BUCKETS]; 3];
+    for it in items.iter().step_by(stride) {
+        for &axis in axes {
+            let k = bucket_of(it.centroid, axis);
+            let one = Guide::around(mean[axis][k], &it.bounds);
+            let acc = &mut guides[axis][k];
+            *acc = Guide {
+                lo: acc.lo.min(one.lo),
+                hi: acc.hi.max(one.hi),
+                phi: acc.phi + one.phi,
+                axis: one.axis,
+                cos_o: acc.cos_o.min(one.cos_o),
+                cos_e: acc.cos_e.min(one.cos_e),
+            };
+        }
+    }
+    for &axis in axes {
+        if chi[axis] <= clo[axis] {
             continue;
         }
-        let bucket = |c: Vec3| (((c[axis] - lo) / (hi - lo) * BUCKETS as f32) as usize).min(BUCKETS - 1);
-        // A bucket's cone: around the mean of its axes, wide enough for each (cheaper than
-        // pairwise unions, and still a bound).
-        let mut count = [0usize; BUCKETS];
-        let mut sum_axis = [DVec3::ZERO; BUCKETS];
-        for &i in ids.iter() {
-            let b = &e[i as usize];
-            let k = bucket(b.centroid());
-            count[k] += 1;
-            sum_axis[k] += b.axis.as_dvec3() * b.phi as f64;
-        }
-        let mut buckets: [Option<LightBounds>; BUCKETS] = [None; BUCKETS];
-        let mean: Vec<DVec3> = sum_axis.iter().map(|s| s.try_normalize().unwrap_or(DVec3::Z)).collect();
-        for &i in ids.iter() {
-            let b = &e[i as usize];
-            let k = bucket(b.centroid());
-            let w = mean[k];
-            let cos_d = w.dot(b.axis.as_dvec3()).clamp(-1.0, 1.0);
-            let (cos_o, sin_o) = (b.cos_o as f64, (1.0 - (b.cos_o as f64).powi(2)).max(0.0).sqrt());
-            let sin_d = (1.0 - cos_d * cos_d).max(0.0).sqrt();
-            // cos(θ_d + θ_o), −1 once the sum passes π.
-            let c = if cos_d * sin_o + sin_d * cos_o < 0.0 && cos_d * cos_o - sin_d * sin_o < 0.0 {
-                -1.0
-            } else {
-                cos_d * cos_o - sin_d * sin_o
-            };
-            let one = LightBounds { axis: w.as_vec3(), cos_o: c as f32, ..*b };
-            buckets[k] = Some(match buckets[k] {
-                None => one,
-                Some(acc) => LightBounds {
-                    lo: acc.lo.min(b.lo),
-                    hi: acc.hi.max(b.hi),
-                    phi: acc.phi + b.phi,
-                    axis: w.as_vec3(),
-                    cos_o: acc.cos_o.min(one.cos_o),
-                    cos_e: acc.cos_e.min(b.cos_e),
-                    two_sided: acc.two_sided || b.two_sided,
-                },
-            });
-        }
+        let count = &counts[axis];
+        let buckets: [Option<Guide>; BUCKETS] =
+            std::array::from_fn(|k| if count[k] > 0 { Some(guides[axis][k]) } else { None });
         let k_r = diag.max_element() / diag[axis].max(1e-30);
-        // Prefix and suffix unions of the buckets.
+        // Prefix unions, then suffixes against them. Only a split just below a non-empty
+        // bucket is a distinct partition.
         let mut below = [None; BUCKETS];
-        let mut acc: Option<LightBounds> = None;
+        let mut acc: Option<Guide> = None;
         for k in 0..BUCKETS {
             if let Some(b) = buckets[k] {
                 acc = Some(acc.map_or(b, |a| a.union(&b)));
             }
             below[k] = acc;
         }
-        let mut acc: Option<LightBounds> = None;
-        let mut n_below = count.iter().sum::<usize>();
+        let mut acc: Option<Guide> = None;
+        let mut n_below = m;
         for k in (1..BUCKETS).rev() {
-            if let Some(b) = buckets[k] {
-                acc = Some(acc.map_or(b, |a| a.union(&b)));
-            }
+            let Some(b) = buckets[k] else { continue };
+            acc = Some(acc.map_or(b, |a| a.union(&b)));
             n_below -= count[k];
             if let (Some(l), Some(r)) = (below[k - 1], acc) {
-                if n_below == 0 || n_below == n || !fits(n_below) {
+                if n_below == 0 || n_below == m || (stride == 1 && !fits(n_below)) {
                     continue;
                 }
-                let c = cost(&l, k_r) + cost(&r, k_r);
+                let c = l.cost(k_r) + r.cost(k_r);
                 if best.is_none_or(|(bc, _, _)| c < bc) {
                     best = Some((c, axis, k));
                 }
@@ -266,25 +372,24 @@ fn split(e: &[LightBounds], ids: &mut [u32], depth: u32) -> usize {
         }
     }
     if let Some((_, axis, k)) = best {
-        let (lo, hi) = (clo[axis], chi[axis]);
-        let bucket = |c: Vec3| (((c[axis] - lo) / (hi - lo) * BUCKETS as f32) as usize).min(BUCKETS - 1);
         let mut mid = 0;
         for j in 0..n {
-            if bucket(e[ids[j] as usize].centroid()) < k {
-                ids.swap(j, mid);
+            if bucket_of(items[j].centroid, axis) < k {
+                items.swap(j, mid);
                 mid += 1;
             }
         }
-        if mid > 0 && mid < n {
+        if mid > 0 && mid < n && fits(mid) {
             return mid;
         }
     }
-    // Median along the widest spread of centroids.
-    let axis = (chi - clo).max_position();
-    let mid = n / 2;
-    ids.select_nth_unstable_by(mid, |a, b| {
-        e[*a as usize].centroid()[axis].total_cmp(&e[*b as usize].centroid()[axis]).then(a.cmp(b))
-    });
+    median_split(items, (chi - clo).max_position())
+}
+
+/// Splits at the median centroid along `axis`.
+fn median_split(items: &mut [Item], axis: usize) -> usize {
+    let mid = items.len() / 2;
+    items.select_nth_unstable_by(mid, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]).then(a.id.cmp(&b.id)));
     mid
 }
 
@@ -327,7 +432,43 @@ mod tests {
                 )
             })
             .collect();
-        let bvh = build_light_bvh(&e);
+        check_tree(&e);
+    }
+
+    #[test]
+    fn large_trees_built_in_parallel_and_from_samples_hold_the_same_invariants() {
+        // Above PARALLEL_ITEMS (subtrees built on other threads) and SAMPLED_EMITTERS (splits
+        // ranked on a sample): a scattered cloud facing every way.
+        let mut state = 7u64;
+        let mut f = move || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let e: Vec<LightBounds> = (0..20_000)
+            .map(|_| {
+                let p = Vec3::new(f(), f(), f()) * 10.0;
+                let n = Vec3::new(f() - 0.5, f() - 0.5, f() - 0.5).normalize_or(Vec3::Z);
+                LightBounds {
+                    lo: p,
+                    hi: p + 0.01,
+                    phi: 10f32.powf(3.0 * f()),
+                    axis: n,
+                    cos_o: 1.0,
+                    cos_e: 0.0,
+                    two_sided: false,
+                }
+            })
+            .collect();
+        assert!(e.len() > 2 * SAMPLED_EMITTERS && e.len() > 2 * PARALLEL_ITEMS);
+        let bvh = check_tree(&e);
+        // The same tree every time, whichever thread built what.
+        assert_eq!(bvh.nodes, build_light_bvh(&e).nodes);
+    }
+
+    /// Every emitter's trail leads to its leaf, depth is capped, and every node bounds its
+    /// children (boxes and cones).
+    fn check_tree(e: &[LightBounds]) -> LightBvh {
+        let bvh = build_light_bvh(e);
         assert_eq!(bvh.nodes.len(), 2 * e.len() - 1);
         assert!(bvh.depth <= MAX_LIGHT_DEPTH);
         for (k, &trail) in bvh.trails.iter().enumerate() {
@@ -353,6 +494,7 @@ mod tests {
                 }
             }
         }
+        bvh
     }
 
     #[test]

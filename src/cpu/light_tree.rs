@@ -25,6 +25,7 @@ pub struct LightNode {
     pub hi: Vec3,
     pub axis: Vec3,
     pub cos_o: f32,
+    pub sin_o: f32,
     pub cos_e: f32,
     /// Child 1 (interior) or the emitter (leaf).
     pub index: u32,
@@ -45,10 +46,11 @@ pub fn load_light_node(scene: &PackedScene, params: &Params, node: u32) -> Light
         hi: Vec3::new(f(r1[0]), f(r1[1]), f(r1[2])),
         axis: oct_decode(r1[3]),
         cos_o: f(r2[0]),
+        sin_o: f(r2[3]),
         cos_e: f(r2[1]),
-        index: r2[2] & !LIGHT_LEAF,
+        index: r2[2] & !(LIGHT_LEAF | LIGHT_TWO_SIDED),
         leaf: r2[2] & LIGHT_LEAF != 0,
-        two_sided: r2[3] & LIGHT_TWO_SIDED != 0,
+        two_sided: r2[2] & LIGHT_TWO_SIDED != 0,
     }
 }
 
@@ -102,9 +104,8 @@ pub fn node_importance(ctx: &LightContext, node: &LightNode) -> Vec2 {
     let sin2_b = r2 / dist2;
     let cos_b = safe_sqrt(1.0 - sin2_b);
     let sin_b = sin2_b.sqrt();
-    let sin_o = safe_sqrt(1.0 - node.cos_o * node.cos_o);
-    let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, node.cos_o);
-    let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, node.cos_o);
+    let cos_x = cos_sub_clamped(sin_w, cos_w, node.sin_o, node.cos_o);
+    let sin_x = sin_sub_clamped(sin_w, cos_w, node.sin_o, node.cos_o);
     let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
     if cos_p <= node.cos_e {
         return Vec2::ZERO;

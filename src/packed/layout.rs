@@ -36,10 +36,10 @@ pub const MAX_EMITTERS: usize = (1 << (32 - TRI_EMITTER_SHIFT)) - 1;
 
 /// Rows (vec4<u32>) per light-tree node in the `lights` buffer.
 pub const LIGHT_NODE_ROWS: u32 = 3;
-/// A light-tree node's index word: set on leaves (the rest is the emitter).
+/// A light-tree node's index word: set on leaves (the rest is the emitter or child 1).
 pub const LIGHT_LEAF: u32 = 1 << 31;
-/// A light-tree node's flags word: some emitter below emits from both faces.
-pub const LIGHT_TWO_SIDED: u32 = 1;
+/// A light-tree node's index word: some emitter below emits from both faces.
+pub const LIGHT_TWO_SIDED: u32 = 1 << 30;
 
 /// Per-triangle vertex attributes: octahedron-encoded normals and tangents
 /// (`pack2x16snorm`) and TEXCOORD_0, one of each per vertex.

@@ -2,14 +2,16 @@
 //! four per row, after the alias table in the `lights` buffer (see `PackedScene::light_rows`).
 //!
 //! Node rows: (lo.xyz, phi), (hi.xyz, octahedral axis), (cos θ_o, cos θ_e, child 1 or
-//! emitter | LIGHT_LEAF, LIGHT_TWO_SIDED bit). Floats are stored as f32 bits, unquantized,
-//! so the boxes are exact; only the axis is quantized, and θ_o is widened by its error so
-//! the cone still holds every emitter's normal.
+//! emitter | LIGHT_LEAF | LIGHT_TWO_SIDED, sin θ_o). Floats are stored as f32 bits,
+//! unquantized, so the boxes are exact; only the axis is quantized, and θ_o is widened by
+//! its error so the cone still holds every emitter's normal. sin θ_o is stored so both
+//! twins read the same value instead of each computing it per visit.
 
 use super::layout::{LIGHT_LEAF, LIGHT_TWO_SIDED, PUNCTUAL_SPOT, Punctual};
 use super::octahedral::{oct_decode, oct_encode};
 use crate::accel::light_bvh::{LightBounds, LightBvh, build_light_bvh, widen};
 use glam::Vec3;
+use rayon::prelude::*;
 
 /// The bounds of one emissive triangle: it emits from its front face (cross(e1, e2)) into
 /// the hemisphere there, with power bound radiance luminance × area (importance then bounds
@@ -61,19 +63,21 @@ pub struct PackedLightTree {
 
 pub fn pack_light_tree(emitters: &[LightBounds]) -> PackedLightTree {
     let LightBvh { nodes, trails, depth, build_seconds } = build_light_bvh(emitters);
-    let mut rows = Vec::with_capacity(3 * nodes.len() + trails.len().div_ceil(4));
-    for n in &nodes {
+    let mut rows: Vec<[u32; 4]> = Vec::with_capacity(3 * nodes.len() + trails.len().div_ceil(4));
+    rows.resize(3 * nodes.len(), [0; 4]);
+    rows.par_chunks_mut(3).zip(nodes.par_iter()).for_each(|(out, n)| {
         let b = &n.bounds;
         let axis_bits = oct_encode(b.axis);
         // Widen the cone by the quantized axis' error, plus slack for the GPU's decode.
         let err = (oct_decode(axis_bits).dot(b.axis) as f64).clamp(-1.0, 1.0).acos();
         let cos_o = if b.cos_o <= -1.0 { -1.0 } else { widen(b.cos_o as f64, err + 2e-5) };
+        let sin_o = (1.0 - cos_o * cos_o).max(0.0).sqrt();
         let f = |x: f32| x.to_bits();
-        rows.push([f(b.lo.x), f(b.lo.y), f(b.lo.z), f(b.phi)]);
-        rows.push([f(b.hi.x), f(b.hi.y), f(b.hi.z), axis_bits]);
-        let index = if n.leaf { n.index | LIGHT_LEAF } else { n.index };
-        rows.push([f(cos_o), f(b.cos_e), index, if b.two_sided { LIGHT_TWO_SIDED } else { 0 }]);
-    }
+        let index = n.index | if n.leaf { LIGHT_LEAF } else { 0 } | if b.two_sided { LIGHT_TWO_SIDED } else { 0 };
+        out[0] = [f(b.lo.x), f(b.lo.y), f(b.lo.z), f(b.phi)];
+        out[1] = [f(b.hi.x), f(b.hi.y), f(b.hi.z), axis_bits];
+        out[2] = [f(cos_o), f(b.cos_e), index, f(sin_o)];
+    });
     let trail_offset = rows.len() as u32;
     for chunk in trails.chunks(4) {
         let mut row = [0; 4];
