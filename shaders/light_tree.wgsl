@@ -80,13 +80,14 @@ fn node_importance(ctx: LightContext, node: LightNode) -> vec2<f32> {
     if (dist2 <= r2) {
         return node.phi / d2;
     }
-    let wi = to_p * (1.0 / sqrt(dist2));
+    let inv_d = 1.0 / sqrt(dist2);
+    let wi = to_p * inv_d;
     var cos_w = dot(node.axis, wi);
     if (node.two_sided) {
         cos_w = abs(cos_w);
     }
     let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
-    let sin2_b = r2 / dist2;
+    let sin2_b = r2 * (inv_d * inv_d);
     let cos_b = safe_sqrt(1.0 - sin2_b);
     let sin_b = sqrt(sin2_b);
     let cos_x = cos_sub_clamped(sin_w, cos_w, node.sin_o, node.cos_o);

@@ -2,7 +2,7 @@
 //! root with one random number, and the exact probability of choosing an emitter.
 
 use super::lights::light_entry;
-use crate::packed::{LIGHT_LEAF, LIGHT_NODE_ROWS, LIGHT_TWO_SIDED, PackedScene, oct_decode};
+use crate::packed::{LIGHT_LEAF, LIGHT_NODE_ROWS, LIGHT_TWO_SIDED, PackedScene};
 use crate::params::Params;
 use glam::{Vec2, Vec3};
 
@@ -44,7 +44,8 @@ pub fn load_light_node(scene: &PackedScene, params: &Params, node: u32) -> Light
         lo: Vec3::new(f(r0[0]), f(r0[1]), f(r0[2])),
         phi: f(r0[3]),
         hi: Vec3::new(f(r1[0]), f(r1[1]), f(r1[2])),
-        axis: oct_decode(r1[3]),
+        // oct_decode(r1[3]), decoded once when packed.
+        axis: scene.light_axes[node as usize],
         cos_o: f(r2[0]),
         sin_o: f(r2[3]),
         cos_e: f(r2[1]),
@@ -95,13 +96,14 @@ pub fn node_importance(ctx: &LightContext, node: &LightNode) -> Vec2 {
         // Inside the bounding sphere every direction is possible.
         return node.phi / d2;
     }
-    let wi = to_p * (1.0 / dist2.sqrt());
+    let inv_d = 1.0 / dist2.sqrt();
+    let wi = to_p * inv_d;
     let mut cos_w = node.axis.dot(wi);
     if node.two_sided {
         cos_w = cos_w.abs();
     }
     let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
-    let sin2_b = r2 / dist2;
+    let sin2_b = r2 * (inv_d * inv_d);
     let cos_b = safe_sqrt(1.0 - sin2_b);
     let sin_b = sin2_b.sqrt();
     let cos_x = cos_sub_clamped(sin_w, cos_w, node.sin_o, node.cos_o);

@@ -58,6 +58,9 @@ pub struct PackedScene {
     /// then from `tree_base` the light tree's nodes (`LIGHT_NODE_ROWS` rows each) and from
     /// `trail_base` its emitters' trails, four per row. At least one row.
     pub light_rows: Vec<[u32; 4]>,
+    /// The light tree's node axes decoded (`oct_decode` of each node's axis word), for the
+    /// CPU engine: decoding is a normalization per node visit.
+    pub light_axes: Vec<Vec3>,
     /// Emitters in the light tree (0: no tree): the alias table's triangles, then the point
     /// and spot lights (the punctual lights after the first `directional_count`).
     pub tree_emitters: u32,
@@ -164,9 +167,11 @@ impl PackedScene {
         };
         let mut light_rows: Vec<[u32; 4]> = bytemuck::cast_slice(&lights).to_vec();
         let tree_base = light_rows.len() as u32;
+        let mut light_axes = Vec::new();
         let (tree_emitters, trail_base, light_tree_nodes, light_tree_depth, light_tree_seconds) = match tree {
             Some(t) => {
                 light_rows.extend_from_slice(&t.rows);
+                light_axes = t.rows[..3 * t.nodes].chunks(3).map(|r| octahedral::oct_decode(r[1][3])).collect();
                 (emitters.len() as u32, tree_base + t.trail_offset, t.nodes, t.depth, t.build_seconds)
             }
             None => (0, tree_base, 0, 0, 0.0),
@@ -203,6 +208,7 @@ impl PackedScene {
             materials,
             lights,
             light_rows,
+            light_axes,
             tree_emitters,
             tree_base,
             trail_base,
