@@ -60,6 +60,8 @@ const TRI_EMITTER_SHIFT: u32 = 8u;
 const LIGHT_SAMPLER_POWER: u32 = 0u;
 const LIGHT_SAMPLER_TREE: u32 = 1u;
 // Light-tree nodes: rows per node, the leaf bit of the index word, the two-sided flag.
+// The largest f32 below 1: rescaled numbers stay in [0, 1).
+const ONE_MINUS_EPSILON: f32 = 0.99999994;
 const LIGHT_NODE_ROWS: u32 = 3u;
 const LIGHT_LEAF: u32 = 0x80000000u;
 const LIGHT_TWO_SIDED: u32 = 0x40000000u;

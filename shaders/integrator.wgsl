@@ -92,7 +92,7 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
                 if (strategy == STRATEGY_LIGHT) {
                     w = 0.0;
                 } else if (strategy != STRATEGY_BSDF) {
-                    w = mis_weight(strategy, prev_pdf, light_pdf(prev_ctx, tri, hit.t * hit.t, cos_hit));
+                    w = mis_weight(strategy, prev_pdf, light_pdf(prev_ctx, tri, ray.dir, hit.t * hit.t, cos_hit));
                 }
             }
             radiance += beta * m.emission * w;

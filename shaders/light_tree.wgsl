@@ -29,8 +29,6 @@ struct LightNode {
     two_sided: bool,
 }
 
-// The largest f32 below 1: rescaled numbers stay in [0, 1).
-const ONE_MINUS_EPSILON: f32 = 0.99999994;
 
 fn load_light_node(node: u32) -> LightNode {
     let base = params.tree_base + LIGHT_NODE_ROWS * node;

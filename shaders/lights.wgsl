@@ -67,6 +67,16 @@ fn triangle_solid_angle(p: vec3<f32>, tri: Triangle) -> f32 {
     return select(0.0, omega, omega >= SOLID_ANGLE_MIN && omega <= SOLID_ANGLE_MAX);
 }
 
+// The receiver-cosine warp: |cos| between the shading normal and the directions to the
+// triangle's corners as bilinear weights over the spherical sample square (corners (0, 0)
+// and (1, 0) map to vertex 1, (0, 1) to vertex 0, (1, 1) to vertex 2), floored at 0.01.
+fn receiver_cosine_weights(ctx: LightContext, tri: Triangle) -> vec4<f32> {
+    let c0 = max(abs(dot(ctx.normal, normalize_or_zero(tri.p0 - ctx.point))), 0.01);
+    let c1 = max(abs(dot(ctx.normal, normalize_or_zero(tri.p0 + tri.e1 - ctx.point))), 0.01);
+    let c2 = max(abs(dot(ctx.normal, normalize_or_zero(tri.p0 + tri.e2 - ctx.point))), 0.01);
+    return vec4<f32>(c1, c1, c0, c2);
+}
+
 fn triangle_area(tri: Triangle) -> f32 {
     return 0.5 * length(cross(tri.e1, tri.e2));
 }
@@ -110,8 +120,12 @@ fn sample_light(ctx: LightContext, u: vec3<f32>) -> LightSample {
         omega = triangle_solid_angle(ref_point, tri);
     }
     if (omega > 0.0) {
-        // Uniform in the solid angle: the point is where the sampled direction meets the plane.
-        let s = sample_spherical_triangle(ref_point, tri.p0, tri.p0 + tri.e1, tri.p0 + tri.e2, u.y, u.z);
+        // In the solid angle, warped towards the receiver's cosine; the point is where the
+        // sampled direction meets the plane.
+        let weights = receiver_cosine_weights(ctx, tri);
+        let us = sample_bilinear(u.yz, weights);
+        let warp_pdf = bilinear_pdf(us, weights);
+        let s = sample_spherical_triangle(ref_point, tri.p0, tri.p0 + tri.e1, tri.p0 + tri.e2, us.x, us.y);
         if (!s.ok) {
             return LightSample(normal, INF, ref_point, normal, vec3<f32>(0.0), 0.0, false);
         }
@@ -123,7 +137,7 @@ fn sample_light(ctx: LightContext, u: vec3<f32>) -> LightSample {
         let wi_s = to_point / dist_s;
         var pdf_s = 0.0;
         if (t > 0.0 && dist_s > 0.0) {
-            pdf_s = select_pmf / omega;
+            pdf_s = select_pmf * warp_pdf / omega;
         }
         return LightSample(wi_s, dist_s, point_s, normal, emitted(tri, triangle, bs), pdf_s, false);
     }
@@ -145,9 +159,9 @@ fn sample_light(ctx: LightContext, u: vec3<f32>) -> LightSample {
     return LightSample(wi, dist, point, normal, radiance, pdf, false);
 }
 
-// Solid-angle density with which `sample_light` from `ctx` finds the point of `tri` a ray
-// reached at distance² `dist2` with cosine `cos_light` to the light's normal.
-fn light_pdf(ctx: LightContext, tri: Triangle, dist2: f32, cos_light: f32) -> f32 {
+// Solid-angle density with which `sample_light` from `ctx` finds the point of `tri` a ray in
+// direction `wi` reached at distance² `dist2` with cosine `cos_light` to the light's normal.
+fn light_pdf(ctx: LightContext, tri: Triangle, wi: vec3<f32>, dist2: f32, cos_light: f32) -> f32 {
     if (params.light_sampler != LIGHT_SAMPLER_TREE) {
         return (1.0 - params.env_select) * tri.light_pdf_area * dist2 / abs(cos_light);
     }
@@ -158,7 +172,8 @@ fn light_pdf(ctx: LightContext, tri: Triangle, dist2: f32, cos_light: f32) -> f3
     let pmf = (1.0 - params.env_select) * light_tree_pmf(ctx, emitter - 1u);
     let omega = triangle_solid_angle(ctx.point, tri);
     if (omega > 0.0) {
-        return pmf / omega;
+        let us = invert_spherical_triangle_sample(ctx.point, tri.p0, tri.p0 + tri.e1, tri.p0 + tri.e2, wi);
+        return pmf * bilinear_pdf(us, receiver_cosine_weights(ctx, tri)) / omega;
     }
     return pmf * dist2 / (abs(cos_light) * triangle_area(tri));
 }

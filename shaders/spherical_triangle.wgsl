@@ -14,10 +14,7 @@ fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
 
 // The solid angle of the triangle seen from `p` (van Oosterom & Strackee).
 fn spherical_triangle_area(p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> f32 {
-    let a = normalize_or_zero(v0 - p);
-    let b = normalize_or_zero(v1 - p);
-    let c = normalize_or_zero(v2 - p);
-    return abs(2.0 * atan2(dot(a, cross(b, c)), 1.0 + dot(a, b) + dot(a, c) + dot(b, c)));
+    return unit_triangle_area(normalize_or_zero(v0 - p), normalize_or_zero(v1 - p), normalize_or_zero(v2 - p));
 }
 
 // sin x for |x| ≤ π by our own polynomial (Taylor to x¹³ on [−π/2, π/2]), the same
@@ -110,4 +107,34 @@ fn sample_spherical_triangle(
         return fail;
     }
     return SphericalSample(normalize(w), true);
+}
+
+// The (u0, u1) that `sample_spherical_triangle` maps to the direction `w` (Arvo's
+// inversion, with both areas from the van Oosterom–Strackee formula, which keeps small
+// sub-triangles in f32), for the density of a BSDF hit under the receiver-cosine warp.
+fn invert_spherical_triangle_sample(
+    p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, w: vec3<f32>
+) -> vec2<f32> {
+    let a = normalize_or_zero(v0 - p);
+    let b = normalize_or_zero(v1 - p);
+    let c = normalize_or_zero(v2 - p);
+    // c': where the great circle through b and w meets the arc a→c.
+    var cp = normalize_or_zero(cross(cross(b, w), cross(c, a)));
+    if (dot(cp, a + c) < 0.0) {
+        cp = -cp;
+    }
+    let u0 = unit_triangle_area(a, b, cp) / unit_triangle_area(a, b, c);
+    // 1 − x·y as ½|x − y|², as the sampling computes it.
+    let w_b = w - b;
+    let cp_b = cp - b;
+    let u = vec2<f32>(u0, dot(w_b, w_b) / dot(cp_b, cp_b));
+    if (!(abs(u.x) < INF && abs(u.y) < INF)) {
+        return vec2<f32>(0.5);
+    }
+    return clamp(u, vec2<f32>(0.0), vec2<f32>(1.0));
+}
+
+// The solid angle of the spherical triangle of unit vectors a, b, c.
+fn unit_triangle_area(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
+    return abs(2.0 * atan2(dot(a, cross(b, c)), 1.0 + dot(a, b) + dot(a, c) + dot(b, c)));
 }

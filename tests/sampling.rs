@@ -13,7 +13,7 @@ use veach::cpu::bvh::{NO_HIT, Ray, intersect_closest};
 use veach::cpu::environment::{environment_pdf, sample_environment};
 use veach::cpu::light_tree::LightContext;
 use veach::cpu::lights::{light_pdf, sample_light};
-use veach::cpu::sampling::{sample_uniform_disk, sample_uniform_triangle};
+use veach::cpu::sampling::{bilinear_pdf, sample_bilinear, sample_uniform_disk, sample_uniform_triangle};
 use veach::params::Params;
 use veach::{Environment, EnvironmentMap, LightSampler, PackedScene, Settings};
 
@@ -74,7 +74,7 @@ fn light_densities(scene: &PackedScene, params: &Params, ctx: &LightContext, wi:
         let n = Vec3::from(tri.e1).cross(Vec3::from(tri.e2)).normalize();
         let cos = -wi.dot(n);
         if tri.light_pdf_area > 0.0 && cos > 0.0 {
-            lamp = light_pdf(scene, params, ctx, tri, hit.t * hit.t, cos) as f64;
+            lamp = light_pdf(scene, params, ctx, tri, wi, hit.t * hit.t, cos) as f64;
         }
     }
     (env, lamp)
@@ -186,6 +186,56 @@ fn triangle_and_lens_warps_match_their_pdfs() {
         |p| if p.length_squared() <= 1.0 { std::f64::consts::FRAC_1_PI } else { 0.0 },
     );
     r.assert_passes("sample_uniform_disk (the thin lens)", 0.01, 2);
+}
+
+/// The receiver-cosine warp: `sample_bilinear` draws `bilinear_pdf`, for weights as the
+/// light sampler makes them (two equal corners) and for skewed ones down to the 0.01 floor.
+#[test]
+fn bilinear_warp_matches_its_pdf() {
+    let mut rng = Lcg(11);
+    for w in [[0.8, 0.8, 0.3, 0.6], [0.01, 0.01, 1.0, 0.2], [1.0, 0.05, 0.4, 0.01], [0.5; 4]] {
+        let what = format!("sample_bilinear {w:?}");
+        let r = chi2::plane(
+            &what,
+            (Vec2::ZERO, Vec2::ONE),
+            (20, 4),
+            200_000,
+            || Some(sample_bilinear(Vec2::new(rng.f(), rng.f()), w)),
+            |p| bilinear_pdf(p, w) as f64,
+        );
+        assert!((r.total - 1.0).abs() < 1e-3, "{what}: the density integrates to {}", r.total);
+        r.assert_passes(&what, 0.01, 4);
+    }
+}
+
+/// `invert_spherical_triangle_sample` undoes `sample_spherical_triangle` closely enough that
+/// the warp's density read at the inverted sample (what a BSDF hit's MIS weight uses) is the
+/// one the light sample reported, for triangles across the solid-angle range the light
+/// sampler uses and receivers that see them from the front, edge-on and at a slant.
+#[test]
+fn spherical_triangle_inversion_recovers_the_sample() {
+    use veach::cpu::spherical_triangle::{
+        SOLID_ANGLE_MAX, SOLID_ANGLE_MIN, invert_spherical_triangle_sample, sample_spherical_triangle,
+        spherical_triangle_area,
+    };
+    let mut rng = Lcg(23);
+    for s in [0.4f32, 1.0, 3.0, 30.0] {
+        let v = [Vec3::new(0.0, 0.0, 3.0), Vec3::new(s, 0.0, 3.0), Vec3::new(0.0, 0.8 * s, 3.0 + 0.5 * s)];
+        let omega = spherical_triangle_area(Vec3::ZERO, v[0], v[1], v[2]);
+        assert!((SOLID_ANGLE_MIN..=SOLID_ANGLE_MAX).contains(&omega), "size {s}: Ω = {omega}");
+        for n in [Vec3::Z, Vec3::X, Vec3::new(-0.6, 0.3, 0.74).normalize()] {
+            let c = |p: Vec3| n.dot(p.normalize()).abs().max(0.01);
+            let weights = [c(v[1]), c(v[1]), c(v[0]), c(v[2])];
+            let mut worst = 0.0f32;
+            for _ in 0..20_000 {
+                let u = sample_bilinear(Vec2::new(rng.f(), rng.f()), weights);
+                let w = sample_spherical_triangle(Vec3::ZERO, v[0], v[1], v[2], u.x, u.y).expect("sample");
+                let back = invert_spherical_triangle_sample(Vec3::ZERO, v[0], v[1], v[2], w);
+                worst = worst.max((bilinear_pdf(back, weights) / bilinear_pdf(u, weights) - 1.0).abs());
+            }
+            assert!(worst < 0.02, "size {s} (Ω = {omega}), normal {n}: the density read back is off by {worst}");
+        }
+    }
 }
 
 /// The harness rejects a sampler that does not draw its pdf (a 5 % distortion).

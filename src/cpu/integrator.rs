@@ -108,7 +108,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
                         w = mis_weight(
                             strategy,
                             prev_pdf,
-                            light_pdf(scene, params, &prev_ctx, tri, hit.t * hit.t, cos_hit),
+                            light_pdf(scene, params, &prev_ctx, tri, ray.dir, hit.t * hit.t, cos_hit),
                         )
                     }
                 }

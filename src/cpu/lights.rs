@@ -4,8 +4,11 @@ use super::bvh::INF;
 use super::environment::{environment_pdf, environment_radiance, sample_environment};
 use super::light_tree::{LightContext, ONE_MINUS_EPSILON, light_tree_pmf, sample_light_tree};
 use super::material::{material_at, triangle_uv};
-use super::sampling::sample_uniform_triangle;
-use super::spherical_triangle::{SOLID_ANGLE_MAX, SOLID_ANGLE_MIN, sample_spherical_triangle, spherical_triangle_area};
+use super::sampling::{bilinear_pdf, sample_bilinear, sample_uniform_triangle};
+use super::spherical_triangle::{
+    SOLID_ANGLE_MAX, SOLID_ANGLE_MIN, invert_spherical_triangle_sample, sample_spherical_triangle,
+    spherical_triangle_area,
+};
 use crate::packed::{
     LightEntry, NO_TEXTURE, PUNCTUAL_POINT, PUNCTUAL_SPOT, PackedScene, Punctual, TRI_EMITTER_SHIFT, Triangle,
 };
@@ -78,8 +81,12 @@ pub fn sample_light(scene: &PackedScene, params: &Params, ctx: &LightContext, u:
     let tree = params.light_sampler == LIGHT_SAMPLER_TREE;
     let omega = if tree { triangle_solid_angle(ref_point, tri) } else { 0.0 };
     if omega > 0.0 {
-        // Uniform in the solid angle: the point is where the sampled direction meets the plane.
-        let Some(w) = sample_spherical_triangle(ref_point, p0, p0 + e1, p0 + e2, u.y, u.z) else {
+        // In the solid angle, warped towards the receiver's cosine; the point is where the
+        // sampled direction meets the plane.
+        let weights = receiver_cosine_weights(ctx, tri);
+        let us = sample_bilinear(Vec2::new(u.y, u.z), weights);
+        let warp_pdf = bilinear_pdf(us, weights);
+        let Some(w) = sample_spherical_triangle(ref_point, p0, p0 + e1, p0 + e2, us.x, us.y) else {
             return LightSample {
                 wi: normal,
                 dist: INF,
@@ -97,7 +104,7 @@ pub fn sample_light(scene: &PackedScene, params: &Params, ctx: &LightContext, u:
         let dist = to_light.length();
         let wi = to_light / dist;
         let radiance = emitted(scene, tri, triangle, b);
-        let pdf = if t > 0.0 && dist > 0.0 { select_pmf / omega } else { 0.0 };
+        let pdf = if t > 0.0 && dist > 0.0 { select_pmf * warp_pdf / omega } else { 0.0 };
         return LightSample { wi, dist, point, normal, radiance, pdf, delta: false };
     }
     let b = sample_uniform_triangle(Vec2::new(u.y, u.z));
@@ -154,6 +161,17 @@ pub fn triangle_solid_angle(p: Vec3, tri: &Triangle) -> f32 {
     if (SOLID_ANGLE_MIN..=SOLID_ANGLE_MAX).contains(&omega) { omega } else { 0.0 }
 }
 
+/// The receiver-cosine warp (pbrt-v4's): |cos| between the shading normal and the directions
+/// to the triangle's corners, as bilinear weights over the spherical sample square, whose
+/// corners (0, 0) and (1, 0) map to vertex 1, (0, 1) to vertex 0 and (1, 1) to vertex 2.
+/// Floored at 0.01 so that no part of the triangle becomes unreachable.
+pub fn receiver_cosine_weights(ctx: &LightContext, tri: &Triangle) -> [f32; 4] {
+    let p0 = Vec3::from(tri.p0);
+    let cosine = |v: Vec3| ctx.normal.dot((v - ctx.point).normalize_or_zero()).abs().max(0.01);
+    let (c0, c1, c2) = (cosine(p0), cosine(p0 + Vec3::from(tri.e1)), cosine(p0 + Vec3::from(tri.e2)));
+    [c1, c1, c0, c2]
+}
+
 /// Alias-table entry `slot` (its row of the `lights` buffer).
 pub fn light_entry(scene: &PackedScene, slot: u32) -> LightEntry {
     bytemuck::cast(scene.light_rows[slot as usize])
@@ -164,12 +182,14 @@ pub fn triangle_area(tri: &Triangle) -> f32 {
 }
 
 /// Solid-angle density with which `sample_light` from `ctx` finds the point of `tri` that a
-/// ray reached at distance² `dist2` with cosine `cos_light` to the light's normal.
+/// ray in direction `wi` reached at distance² `dist2` with cosine `cos_light` to the light's
+/// normal.
 pub fn light_pdf(
     scene: &PackedScene,
     params: &Params,
     ctx: &LightContext,
     tri: &Triangle,
+    wi: Vec3,
     dist2: f32,
     cos_light: f32,
 ) -> f32 {
@@ -183,7 +203,9 @@ pub fn light_pdf(
     let pmf = (1.0 - params.env_select) * light_tree_pmf(scene, params, ctx, emitter - 1);
     let omega = triangle_solid_angle(ctx.point, tri);
     if omega > 0.0 {
-        return pmf / omega;
+        let (p0, e1, e2) = (Vec3::from(tri.p0), Vec3::from(tri.e1), Vec3::from(tri.e2));
+        let us = invert_spherical_triangle_sample(ctx.point, p0, p0 + e1, p0 + e2, wi);
+        return pmf * bilinear_pdf(us, receiver_cosine_weights(ctx, tri)) / omega;
     }
     pmf * dist2 / (cos_light.abs() * triangle_area(tri))
 }

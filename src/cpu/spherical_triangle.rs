@@ -5,17 +5,14 @@
 //! the light sampler samples by area instead; sampling and the pdf of a BSDF hit take the
 //! same branch through `spherical_triangle_area`.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 pub const SOLID_ANGLE_MIN: f32 = 1e-3;
 pub const SOLID_ANGLE_MAX: f32 = 6.22;
 
 /// The solid angle of the triangle (v0, v1, v2) seen from `p` (van Oosterom & Strackee).
 pub fn spherical_triangle_area(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> f32 {
-    let a = (v0 - p).normalize_or_zero();
-    let b = (v1 - p).normalize_or_zero();
-    let c = (v2 - p).normalize_or_zero();
-    (2.0 * a.dot(b.cross(c)).atan2(1.0 + a.dot(b) + a.dot(c) + b.dot(c))).abs()
+    unit_triangle_area((v0 - p).normalize_or_zero(), (v1 - p).normalize_or_zero(), (v2 - p).normalize_or_zero())
 }
 
 /// sin x for |x| ≤ π by a polynomial of our own (Taylor to x¹³ on [−π/2, π/2], error below
@@ -103,4 +100,32 @@ pub fn sample_spherical_triangle(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3, u0: f32,
         return None;
     }
     Some(w.normalize())
+}
+
+/// The (u0, u1) that `sample_spherical_triangle` maps to the direction `w` (Arvo's
+/// inversion, as pbrt-v4 does it, but with both areas from the van Oosterom–Strackee formula:
+/// the angle sum loses the small sub-triangles in f32, and pbrt's 0.1° cut-off near vertex 0
+/// moves u0 by percents on small triangles). The density of a BSDF hit under the
+/// receiver-cosine warp is read there. (0.5, 0.5) when the triangle is degenerate from `p`.
+pub fn invert_spherical_triangle_sample(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3, w: Vec3) -> Vec2 {
+    let centre = Vec2::splat(0.5);
+    let a = (v0 - p).normalize_or_zero();
+    let b = (v1 - p).normalize_or_zero();
+    let c = (v2 - p).normalize_or_zero();
+    // c': where the great circle through b and w meets the arc a→c.
+    let mut cp = b.cross(w).cross(c.cross(a)).normalize_or_zero();
+    if cp.dot(a + c) < 0.0 {
+        cp = -cp;
+    }
+    let area = unit_triangle_area(a, b, c);
+    let u0 = unit_triangle_area(a, b, cp) / area;
+    // 1 − x·y as ½|x − y|², as the sampling computes it.
+    let u1 = (w - b).length_squared() / (cp - b).length_squared();
+    let u = Vec2::new(u0, u1);
+    if u.is_finite() { u.clamp(Vec2::ZERO, Vec2::ONE) } else { centre }
+}
+
+/// The solid angle of the spherical triangle of unit vectors a, b, c.
+fn unit_triangle_area(a: Vec3, b: Vec3, c: Vec3) -> f32 {
+    (2.0 * a.dot(b.cross(c)).atan2(1.0 + a.dot(b) + a.dot(c) + b.dot(c))).abs()
 }
