@@ -125,6 +125,26 @@ struct TreeChoice {
     pmf: f32,
 }
 
+// The children of interior node `node` (stored at index `at`) with their importances;
+// ok = false at a dead end (neither child can contribute). Both walks step through this.
+struct Children {
+    c0: LightNode,
+    c1: LightNode,
+    i0: vec2<f32>,
+    i1: vec2<f32>,
+    total: vec2<f32>,
+    ok: bool,
+}
+
+fn children(ctx: LightContext, node: LightNode, at: u32) -> Children {
+    let c0 = load_light_node(at + 1u);
+    let c1 = load_light_node(node.index);
+    let i0 = child_importance(ctx, c0);
+    let i1 = child_importance(ctx, c1);
+    let total = i0 + i1;
+    return Children(c0, c1, i0, i1, total, total.x > 0.0);
+}
+
 fn sample_light_tree(ctx: LightContext, u_in: f32) -> TreeChoice {
     var node = load_light_node(0u);
     if (node.leaf) {
@@ -134,25 +154,21 @@ fn sample_light_tree(ctx: LightContext, u_in: f32) -> TreeChoice {
     var u = u_in;
     var pmf = 1.0;
     loop {
-        let c0 = load_light_node(at + 1u);
-        let c1 = load_light_node(node.index);
-        let i0 = child_importance(ctx, c0);
-        let i1 = child_importance(ctx, c1);
-        let total = i0 + i1;
-        if (!(total.x > 0.0)) {
+        let ch = children(ctx, node, at);
+        if (!ch.ok) {
             return TreeChoice(0u, 0.0);
         }
-        let p0 = child_share(i0, total);
+        let p0 = child_share(ch.i0, ch.total);
         if (u < p0) {
             u = min(u / p0, ONE_MINUS_EPSILON);
             pmf *= p0;
             at += 1u;
-            node = c0;
+            node = ch.c0;
         } else {
             u = min((u - p0) / (1.0 - p0), ONE_MINUS_EPSILON);
-            pmf *= child_share(i1, total);
+            pmf *= child_share(ch.i1, ch.total);
             at = node.index;
-            node = c1;
+            node = ch.c1;
         }
         if (node.leaf) {
             return TreeChoice(node.index, pmf);
@@ -170,22 +186,18 @@ fn light_tree_pmf(ctx: LightContext, emitter: u32) -> f32 {
     var at = 0u;
     var pmf = 1.0;
     loop {
-        let c0 = load_light_node(at + 1u);
-        let c1 = load_light_node(node.index);
-        let i0 = child_importance(ctx, c0);
-        let i1 = child_importance(ctx, c1);
-        let total = i0 + i1;
-        if (!(total.x > 0.0)) {
+        let ch = children(ctx, node, at);
+        if (!ch.ok) {
             return 0.0;
         }
         if ((trail & 1u) == 0u) {
-            pmf *= child_share(i0, total);
+            pmf *= child_share(ch.i0, ch.total);
             at += 1u;
-            node = c0;
+            node = ch.c0;
         } else {
-            pmf *= child_share(i1, total);
+            pmf *= child_share(ch.i1, ch.total);
             at = node.index;
-            node = c1;
+            node = ch.c1;
         }
         trail = trail >> 1u;
         if (node.leaf) {

@@ -139,6 +139,27 @@ pub fn child_share(i: Vec2, total: Vec2) -> f32 {
     0.5 * (i.x / total.x + i.y / total.y)
 }
 
+/// The children of interior node `node` (stored at index `at`) with their importances, or
+/// None at a dead end (neither child can contribute). Both walks step through this.
+struct Children {
+    c0: LightNode,
+    c1: LightNode,
+    i0: Vec2,
+    i1: Vec2,
+    total: Vec2,
+}
+
+fn children(scene: &PackedScene, params: &Params, ctx: &LightContext, node: &LightNode, at: u32) -> Option<Children> {
+    let c0 = load_light_node(scene, params, at + 1);
+    let c1 = load_light_node(scene, params, node.index);
+    let (i0, i1) = (child_importance(scene, params, ctx, &c0), child_importance(scene, params, ctx, &c1));
+    let total = i0 + i1;
+    if total.x.is_nan() || total.x <= 0.0 {
+        return None;
+    }
+    Some(Children { c0, c1, i0, i1, total })
+}
+
 /// Chooses an emitter: at each node a child by its share, `u` rescaled into the chosen
 /// interval. Returns (emitter, probability); probability 0: nothing to choose (every emitter
 /// of the subtree reached provably contributes nothing).
@@ -151,24 +172,18 @@ pub fn sample_light_tree(scene: &PackedScene, params: &Params, ctx: &LightContex
     let mut u = u;
     let mut pmf = 1.0f32;
     loop {
-        let c0 = load_light_node(scene, params, at + 1);
-        let c1 = load_light_node(scene, params, node.index);
-        let (i0, i1) = (child_importance(scene, params, ctx, &c0), child_importance(scene, params, ctx, &c1));
-        let total = i0 + i1;
-        if total.x.is_nan() || total.x <= 0.0 {
-            return (0, 0.0);
-        }
-        let p0 = child_share(i0, total);
+        let Some(ch) = children(scene, params, ctx, &node, at) else { return (0, 0.0) };
+        let p0 = child_share(ch.i0, ch.total);
         if u < p0 {
             u = (u / p0).min(ONE_MINUS_EPSILON);
             pmf *= p0;
             at += 1;
-            node = c0;
+            node = ch.c0;
         } else {
             u = ((u - p0) / (1.0 - p0)).min(ONE_MINUS_EPSILON);
-            pmf *= child_share(i1, total);
+            pmf *= child_share(ch.i1, ch.total);
             at = node.index;
-            node = c1;
+            node = ch.c1;
         }
         if node.leaf {
             return (node.index, pmf);
@@ -188,21 +203,15 @@ pub fn light_tree_pmf(scene: &PackedScene, params: &Params, ctx: &LightContext, 
     let mut at = 0u32;
     let mut pmf = 1.0f32;
     loop {
-        let c0 = load_light_node(scene, params, at + 1);
-        let c1 = load_light_node(scene, params, node.index);
-        let (i0, i1) = (child_importance(scene, params, ctx, &c0), child_importance(scene, params, ctx, &c1));
-        let total = i0 + i1;
-        if total.x.is_nan() || total.x <= 0.0 {
-            return 0.0;
-        }
+        let Some(ch) = children(scene, params, ctx, &node, at) else { return 0.0 };
         if trail & 1 == 0 {
-            pmf *= child_share(i0, total);
+            pmf *= child_share(ch.i0, ch.total);
             at += 1;
-            node = c0;
+            node = ch.c0;
         } else {
-            pmf *= child_share(i1, total);
+            pmf *= child_share(ch.i1, ch.total);
             at = node.index;
-            node = c1;
+            node = ch.c1;
         }
         trail >>= 1;
         if node.leaf {
