@@ -194,7 +194,7 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
                 let seconds = t.elapsed().as_secs_f64();
                 let samples = opts.width as f64 * opts.height as f64 * opts.spp as f64;
                 result.renders.push(RenderResult {
-                    backend: format!("{backend:?}").to_lowercase(),
+                    backend: format!("{:?}", r.backend()).to_lowercase(),
                     light_sampler: light_sampler.label(),
                     adapter: r.adapter_name(),
                     seconds,

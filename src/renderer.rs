@@ -38,6 +38,30 @@ impl Renderer {
         match backend {
             Backend::Cpu => Self::build(scene, camera, settings, None),
             Backend::Gpu => Self::build(scene, camera, settings, Some(gpu::GpuContext::new()?)),
+            Backend::Auto => Ok(Self::auto(scene, camera, settings)?.0),
+        }
+    }
+
+    /// The faster engine for this machine, and why, in a phrase for logs and statistics: the
+    /// GPU engine on a hardware adapter; the CPU engine when the only adapter is a software
+    /// one (adapter type CPU: lavapipe, llvmpipe, SwiftShader, WARP), which runs the kernel
+    /// slower than the CPU engine runs its twin (BENCHMARKS.md), or when there is none.
+    pub fn auto(scene: PackedScene, camera: &Camera, settings: &Settings) -> Result<(Renderer, String), Error> {
+        match gpu::adapter_info() {
+            Ok(info) if info.device_type == wgpu::DeviceType::Cpu => {
+                let why = format!(
+                    "the only GPU adapter ({}) is a software one, slower here than the CPU backend; \
+                     --backend gpu uses it anyway",
+                    info.name
+                );
+                Ok((Self::build(scene, camera, settings, None)?, why))
+            }
+            Ok(info) => {
+                let why = format!("hardware GPU adapter ({})", info.name);
+                Ok((Self::build(scene, camera, settings, Some(gpu::GpuContext::new()?))?, why))
+            }
+            Err(Error::NoAdapter(_)) => Ok((Self::build(scene, camera, settings, None)?, "no GPU adapter".to_string())),
+            Err(e) => Err(e),
         }
     }
 

@@ -82,10 +82,12 @@ impl LightSampler {
     }
 }
 
-/// Which engine renders: the WGSL kernel through wgpu, or the CPU reference.
+/// Which engine renders: the WGSL kernel through wgpu, or the CPU reference; `Auto` picks
+/// the faster one for this machine (see `Renderer::auto`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Backend {
+    Auto,
     Gpu,
     Cpu,
 }

@@ -101,6 +101,7 @@ fn renders_png_and_exr_with_stats() {
             "seed",
             "adapter",
             "backend",
+            "backend_reason",
             "seconds_total",
             "seconds_render",
             "samples_per_second",
@@ -220,7 +221,7 @@ fn strategies_sheet_has_four_labelled_panels() {
 }
 
 #[test]
-fn without_a_vulkan_driver_falls_back_to_cpu_or_says_how_to_get_one() {
+fn without_a_vulkan_driver_renders_on_the_cpu_or_says_how_to_get_one() {
     let d = temp_dir("nogpu");
     let cbox = common::asset("cornell-box.gltf");
     let out = d.join("a.png");
@@ -230,12 +231,71 @@ fn without_a_vulkan_driver_falls_back_to_cpu_or_says_how_to_get_one() {
     let r = veach(&args, &no_driver);
     let stderr = String::from_utf8_lossy(&r.stderr);
     assert!(r.status.success(), "{stderr}");
-    assert!(stderr.contains("apt-get install mesa-vulkan-drivers") && stderr.contains("CPU"), "{stderr}");
+    // The default engine is the faster one: no driver is no reason to suggest installing one.
+    assert!(stderr.contains("CPU backend") && stderr.contains("no GPU adapter"), "{stderr}");
+    assert!(!stderr.contains("apt-get"), "{stderr}");
     assert!(out.exists());
 
     let mut explicit = args.to_vec();
     explicit.extend(["--backend", "gpu"]);
     assert_user_error(&veach(&explicit, &no_driver), "apt-get install mesa-vulkan-drivers");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `--backend auto` (the default) runs the GPU engine on a hardware adapter and the CPU
+/// engine on a software one (lavapipe here) or with none, says why in `--stats-json`, and
+/// says so in one line when it picks the CPU; `--backend gpu` still runs the kernel.
+#[test]
+fn the_default_backend_is_the_faster_engine() {
+    let d = temp_dir("auto");
+    let cbox = common::asset("cornell-box.gltf");
+    let stats = d.join("stats.json");
+    let run = |extra: &[&str]| {
+        let out = d.join("a.png");
+        let mut args = vec![
+            "render",
+            cbox.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--spp",
+            "1",
+            "--stats-json",
+            stats.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let r = veach(&args, &[]);
+        let stderr = String::from_utf8_lossy(&r.stderr).to_string();
+        assert!(r.status.success(), "{stderr}");
+        let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+        (s, stderr)
+    };
+    let (s, stderr) = run(&[]);
+    let reason = s["backend_reason"].as_str().unwrap_or_default().to_string();
+    assert_eq!(run(&["--backend", "auto"]).0["backend"], s["backend"], "auto is the default");
+    match veach::gpu::adapter_info() {
+        Ok(info) if info.device_type == wgpu::DeviceType::Cpu => {
+            assert_eq!(s["backend"], "cpu", "{reason}");
+            assert!(reason.contains("software") && reason.contains(&info.name), "{reason}");
+            assert!(stderr.contains("rendering on the CPU backend") && stderr.contains("--backend gpu"), "{stderr}");
+            let (forced, _) = run(&["--backend", "gpu"]);
+            assert_eq!(
+                (forced["backend"].as_str(), forced["backend_reason"].as_str()),
+                (Some("gpu"), Some("requested"))
+            );
+        }
+        Ok(info) => {
+            assert_eq!(s["backend"], "gpu", "{reason}");
+            assert!(reason.contains(&info.name), "{reason}");
+        }
+        Err(_) => {
+            assert_eq!(s["backend"], "cpu");
+            assert!(reason.contains("no GPU adapter"), "{reason}");
+        }
+    }
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -53,6 +53,29 @@ pub enum GeometryPlacement {
     Textures,
 }
 
+/// The adapter `GpuContext::new` opens: WGPU_ADAPTER_NAME's, else the high-performance one.
+fn choose_adapter() -> Result<wgpu::Adapter, Error> {
+    let inst = instance();
+    // WGPU_ADAPTER_NAME picks an adapter by name; an unmatched name is our error, not a panic.
+    let wanted = std::env::var("WGPU_ADAPTER_NAME").ok().map(|s| s.to_lowercase());
+    match wanted {
+        Some(name) => pollster::block_on(inst.enumerate_adapters(BACKENDS.with_env()))
+            .into_iter()
+            .find(|a| a.get_info().name.to_lowercase().contains(&name))
+            .ok_or_else(|| Error::NoAdapter(format!("no GPU adapter matches WGPU_ADAPTER_NAME={name}"))),
+        None => pollster::block_on(inst.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        }))
+        .map_err(|_| Error::NoAdapter(NO_ADAPTER_HINT.to_string())),
+    }
+}
+
+/// What `GpuContext::new` would open, without opening a device.
+pub fn adapter_info() -> Result<wgpu::AdapterInfo, Error> {
+    Ok(choose_adapter()?.get_info())
+}
+
 impl GpuContext {
     /// Wraps a device opened elsewhere (the viewer's window), capturing its errors.
     pub fn from_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> GpuContext {
@@ -72,20 +95,7 @@ impl GpuContext {
     }
 
     pub fn new() -> Result<GpuContext, Error> {
-        let inst = instance();
-        // WGPU_ADAPTER_NAME picks an adapter by name; an unmatched name is our error, not a panic.
-        let wanted = std::env::var("WGPU_ADAPTER_NAME").ok().map(|s| s.to_lowercase());
-        let adapter = match wanted {
-            Some(name) => pollster::block_on(inst.enumerate_adapters(BACKENDS.with_env()))
-                .into_iter()
-                .find(|a| a.get_info().name.to_lowercase().contains(&name))
-                .ok_or_else(|| Error::NoAdapter(format!("no GPU adapter matches WGPU_ADAPTER_NAME={name}")))?,
-            None => pollster::block_on(inst.request_adapter(&wgpu::RequestAdapterOptions {
-                power_preference: wgpu::PowerPreference::HighPerformance,
-                ..Default::default()
-            }))
-            .map_err(|_| Error::NoAdapter(NO_ADAPTER_HINT.to_string()))?,
-        };
+        let adapter = choose_adapter()?;
         let info = adapter.get_info();
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {

@@ -14,7 +14,7 @@ mod textures;
 mod trace;
 
 pub use bindings::TABLE as BINDINGS;
-pub use context::{GeometryPlacement, GpuContext, GpuOptions, NO_ADAPTER_HINT, adapters};
+pub use context::{GeometryPlacement, GpuContext, GpuOptions, NO_ADAPTER_HINT, adapter_info, adapters};
 pub use display::Display;
 pub use renderer::{GpuRenderer, WORKGROUP_SIDE};
 

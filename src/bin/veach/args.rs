@@ -124,7 +124,7 @@ pub struct BenchArgs {
     /// Path segments, as Mitsuba's max_depth (8: up to 7 bounces).
     #[arg(long, default_value_t = 8)]
     pub max_depth: u32,
-    /// Backends to run (repeat the flag for several); default: gpu and cpu.
+    /// Backends to run (repeat the flag for several; auto: the one `render` would pick); default: gpu and cpu.
     #[arg(long, value_enum)]
     pub backend: Vec<Backend>,
     /// Spheres per side in the generated large scene (~16k triangles each; 4 = ~262k).
@@ -167,8 +167,9 @@ pub struct StrategiesArgs {
     pub exposure: f32,
     #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
     pub tonemap: Tonemap,
-    #[arg(long, value_enum)]
-    pub backend: Option<Backend>,
+    /// auto (the faster engine here: the GPU on a hardware adapter, else the CPU), gpu or cpu.
+    #[arg(long, value_enum, default_value_t = Backend::Auto)]
+    pub backend: Backend,
     #[command(flatten)]
     pub look: LookArgs,
 }
@@ -236,9 +237,10 @@ pub struct RenderArgs {
     /// Sample generator: sobol (Owen-scrambled, lower error at equal spp) or independent.
     #[arg(long, value_enum, conflicts_with = "resume", default_value_t = SamplerKind::Sobol)]
     pub sampler: SamplerKind,
-    /// gpu (Vulkan; falls back to cpu with a warning when no adapter exists unless given explicitly) or cpu.
-    #[arg(long, value_enum)]
-    pub backend: Option<Backend>,
+    /// auto (the faster engine here: the GPU on a hardware adapter; the CPU on a software
+    /// adapter such as lavapipe, or with none), gpu or cpu.
+    #[arg(long, value_enum, default_value_t = Backend::Auto)]
+    pub backend: Backend,
     #[command(flatten)]
     pub look: LookArgs,
     /// Render only sample indices START..END (a render-farm split; overrides --spp). Random

@@ -83,24 +83,24 @@ pub fn warn_all(what: &std::path::Path, warnings: &[String]) {
     }
 }
 
-/// A renderer on the requested backend; with none requested, the GPU, or the CPU with a
-/// one-line warning when there is no GPU adapter.
+/// A renderer on the requested backend, and why it is that one (`--stats-json`); with
+/// `auto` (the default) the faster engine for this machine, saying so in one line when that
+/// is the CPU engine.
 pub fn open_renderer(
     packed: veach::PackedScene,
     camera: &veach::Camera,
     settings: &veach::Settings,
-    backend: Option<veach::Backend>,
-) -> Result<veach::Renderer, Error> {
+    backend: veach::Backend,
+) -> Result<(veach::Renderer, String), Error> {
     use veach::{Backend, Renderer};
     match backend {
-        Some(b) => Renderer::new(packed, camera, settings, b),
-        None => match veach::gpu::GpuContext::new() {
-            Ok(ctx) => Renderer::with_context(packed, camera, settings, ctx),
-            Err(Error::NoAdapter(msg)) => {
-                eprintln!("veach: warning: {msg}; rendering on the CPU backend");
-                Renderer::new(packed, camera, settings, Backend::Cpu)
+        Backend::Auto => {
+            let (renderer, why) = Renderer::auto(packed, camera, settings)?;
+            if renderer.backend() == Backend::Cpu {
+                eprintln!("veach: rendering on the CPU backend: {why}");
             }
-            Err(e) => Err(e),
-        },
+            Ok((renderer, format!("auto: {why}")))
+        }
+        b => Ok((Renderer::new(packed, camera, settings, b)?, "requested".to_string())),
     }
 }

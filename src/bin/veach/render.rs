@@ -66,7 +66,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     let packed = veach::PackedScene::new(&loaded.scene);
     let (bvh_nodes, bvh_depth, bvh_seconds) = (packed.bvh_nodes, packed.bvh_depth, packed.bvh_build_seconds);
     let light_tree = (packed.light_tree_nodes, packed.light_tree_depth, packed.light_tree_seconds);
-    let mut renderer = crate::open_renderer(packed, &loaded.camera, &job.settings, args.backend)?;
+    let (mut renderer, backend_reason) = crate::open_renderer(packed, &loaded.camera, &job.settings, args.backend)?;
     let mut done = 0u32;
     if let Some(film) = resumed {
         done = film.samples().min(job.spp());
@@ -167,6 +167,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             "light_tree_build_seconds": light_tree.2,
             "adapter": renderer.adapter_name(),
             "backend": format!("{:?}", renderer.backend()).to_lowercase(),
+            "backend_reason": backend_reason,
             "seconds_total": t0.elapsed().as_secs_f64(),
             "seconds_render": seconds_render,
             "samples_per_second": samples_per_second,

@@ -28,7 +28,7 @@ pub fn run(args: &StrategiesArgs) -> Result<(), Error> {
     args.look.apply(&mut settings);
     let packed = veach::PackedScene::new(&loaded.scene);
     // One renderer for the four panels: only the estimator changes between them.
-    let mut renderer = crate::open_renderer(packed, &loaded.camera, &settings, args.backend)?;
+    let (mut renderer, _) = crate::open_renderer(packed, &loaded.camera, &settings, args.backend)?;
     let mut sheet = image::RgbImage::new(4 * w, h + LABEL_BAR);
     for (k, strategy) in Strategy::ALL.into_iter().enumerate() {
         renderer.reset(&loaded.camera, &Settings { strategy, ..settings.clone() })?;
