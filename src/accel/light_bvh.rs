@@ -9,6 +9,11 @@
 //! (SAOH) over 12 buckets per axis; one emitter per leaf, nodes in depth-first order (child 0
 //! follows its parent). Each emitter keeps the trail of child choices from the root (bit k:
 //! the child taken at depth k), which gives the exact probability of choosing it for MIS.
+//!
+//! Speed (1 M emitters in ~2 s on 2 cores, BENCHMARKS.md): the SAOH only ranks splits, so it
+//! works on f32 guides without transcendental calls, on one axis in small nodes and on a
+//! sample of the emitters in large ones; the nodes' own cones are exact (f64) unions.
+//! Sibling subtrees are built in parallel into slots known in advance.
 
 use glam::{DVec3, Vec3};
 

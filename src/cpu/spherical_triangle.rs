@@ -3,7 +3,9 @@
 //! Below `SOLID_ANGLE_MIN` (tiny or distant triangles, where area sampling is as good and
 //! the spherical formulas lose precision) and above `SOLID_ANGLE_MAX` (nearly a hemisphere)
 //! the light sampler samples by area instead; sampling and the pdf of a BSDF hit take the
-//! same branch through `spherical_triangle_area`.
+//! same branch through `spherical_triangle_area`. Within the range the sample square is
+//! first warped towards the receiver's cosine (`lights::receiver_cosine_weights`), and a BSDF
+//! hit reads that warp's density through `invert_spherical_triangle_sample`.
 
 use glam::{Vec2, Vec3};
 
