@@ -183,7 +183,13 @@ struct Params {
     // The first punctual lights, sampled in an estimate of their own (all with the power
     // sampler; the directional ones, which come first, with the tree).
     separate_punctuals: u32,
-    pad: u32,
+    // Firefly control: the largest component sum a contribution of direct light (paths of
+    // at most 2 segments) or indirect light adds to the pixel (f32 max: off).
+    clamp_direct: f32,
+    clamp_indirect: f32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 struct Ray {

@@ -47,6 +47,15 @@ fn unoccluded(origin: vec3<f32>, ls: LightSample) -> bool {
     return !occluded(Ray(origin, target_point - origin), 1.0);
 }
 
+// Firefly control: a contribution carried by a path of `segments` segments, scaled so that
+// its components sum to at most the limit of its kind (direct light: seen directly or after
+// one bounce). Contributions are never negative.
+fn clamp_contribution(c: vec3<f32>, segments: u32) -> vec3<f32> {
+    let limit = select(params.clamp_indirect, params.clamp_direct, segments <= 2u);
+    let sum = c.x + c.y + c.z;
+    return select(c, c * (limit / sum), sum > limit);
+}
+
 // Radiance arriving along a camera ray. Path depth counts segments (Mitsuba's max_depth).
 fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
     let strategy = params.strategy;
@@ -70,7 +79,7 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
                     w = mis_weight(strategy, prev_pdf, environment_pdf(ray.dir));
                 }
             }
-            radiance += beta * environment_radiance(ray.dir) * w;
+            radiance += clamp_contribution(beta * environment_radiance(ray.dir) * w, depth);
             break;
         }
         let tri = world_triangle(hit.tri, hit.instance);
@@ -95,7 +104,7 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
                     w = mis_weight(strategy, prev_pdf, light_pdf(prev_ctx, tri, ray.dir, hit.t * hit.t, cos_hit));
                 }
             }
-            radiance += beta * m.emission * w;
+            radiance += clamp_contribution(beta * m.emission * w, depth);
         }
         if (params.max_depth != 0u && depth >= params.max_depth) {
             break;
@@ -129,14 +138,15 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
                     if (strategy != STRATEGY_LIGHT && !ls.delta) {
                         w = mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, to_local(frame, ls.wi), eta));
                     }
-                    radiance += beta * c * (w / ls.pdf);
+                    radiance += clamp_contribution(beta * c * (w / ls.pdf), depth + 1u);
                 }
             }
         }
         // Punctual lights outside the tree: only next-event estimation can reach them.
         if (PUNCTUAL_LIGHTS && params.separate_punctuals > 0u) {
             let ls = sample_punctual(point, sample_1d(sampler));
-            radiance += beta * connect(m, frame, wo, eta, point, ng, ls) / max(ls.pdf, 1e-30);
+            let c = beta * connect(m, frame, wo, eta, point, ng, ls) / max(ls.pdf, 1e-30);
+            radiance += clamp_contribution(c, depth + 1u);
         }
 
         // BSDF sample: continues the path (and finds emitters for the MIS estimator).

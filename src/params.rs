@@ -57,7 +57,14 @@ pub struct Params {
     /// The first punctual lights, sampled in an estimate of their own: all of them with the
     /// power sampler, the directional ones with the tree (they come first).
     pub separate_punctuals: u32,
-    pub pad: u32,
+    /// Firefly control: a contribution to the pixel whose components sum above the limit is
+    /// scaled down to it; direct light (paths of ≤ 2 segments) and indirect light have their
+    /// own limits (`f32::MAX`: off).
+    pub clamp_direct: f32,
+    pub clamp_indirect: f32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 /// Russian roulette starts once a path has this many segments.
@@ -120,7 +127,11 @@ impl Params {
             tree_base: scene.tree_base,
             trail_base: scene.trail_base,
             separate_punctuals: if tree { scene.directional_count } else { scene.punctual_count },
-            pad: 0,
+            clamp_direct: settings.clamp_direct.unwrap_or(f32::MAX),
+            clamp_indirect: settings.clamp_indirect.unwrap_or(f32::MAX),
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         }
     }
 }

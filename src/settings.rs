@@ -155,6 +155,14 @@ pub struct Settings {
     /// Renders saved before light samplers existed sampled lights by power.
     #[serde(default)]
     pub light_sampler: LightSampler,
+    /// Firefly control (biased; None: off): a sample's contribution of direct light (seen
+    /// directly or after one bounce) is scaled so that its R + G + B is at most this, as
+    /// Cycles' "clamp direct" does.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clamp_direct: Option<f32>,
+    /// The same limit for indirect light (paths of three segments or more).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clamp_indirect: Option<f32>,
 }
 
 impl Default for Settings {
@@ -174,11 +182,18 @@ impl Default for Settings {
             focus_distance: None,
             sampler: SamplerKind::Sobol,
             light_sampler: LightSampler::Tree,
+            clamp_direct: None,
+            clamp_indirect: None,
         }
     }
 }
 
 impl Settings {
+    /// Whether the estimate is biased on purpose (firefly clamping).
+    pub fn biased(&self) -> bool {
+        self.clamp_direct.is_some() || self.clamp_indirect.is_some()
+    }
+
     /// The window rendered: the tile, or the whole image.
     pub fn window(&self) -> Tile {
         self.tile.unwrap_or(Tile { x: 0, y: 0, width: self.width, height: self.height })
@@ -217,6 +232,13 @@ impl Settings {
                 "environment strength {}: expected a finite value ≥ 0",
                 self.env_strength
             )));
+        }
+        for (name, c) in [("direct clamp", self.clamp_direct), ("indirect clamp", self.clamp_indirect)] {
+            if let Some(c) = c
+                && !(c.is_finite() && c > 0.0)
+            {
+                return Err(Error::Input(format!("{name} {c}: expected a finite limit > 0")));
+            }
         }
         if let Some(c) = self.env_color
             && !c.iter().all(|v| v.is_finite() && *v >= 0.0)

@@ -53,6 +53,10 @@ fn bad_inputs_exit_2_with_one_line_and_no_output() {
     assert_user_error(&veach(&["render", cbox, "-o", d.join("out.jpg").to_str().unwrap()], &[]), "out.jpg");
     assert_user_error(&veach(&["render", cbox, "-o", d.join("no/such/dir/out.png").to_str().unwrap()], &[]), "out.png");
     assert_user_error(&veach(&["render", cbox, "-o", out, "--camera", "nope"], &[]), "nope");
+    // Flags clap refuses are one line too, naming the flag.
+    assert_user_error(&veach(&["render", cbox, "-o", out, "--spp", "many"], &[]), "--spp");
+    assert_user_error(&veach(&["render", cbox], &[]), "--output");
+    assert_user_error(&veach(&["render", cbox, "-o", out, "--no-such-flag"], &[]), "--no-such-flag");
 
     // Leftover files only: the failed runs wrote nothing (broken inputs are ours).
     let mut left: Vec<String> =
@@ -296,6 +300,110 @@ fn the_default_backend_is_the_faster_engine() {
             assert!(reason.contains("no GPU adapter"), "{reason}");
         }
     }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `--time` renders until the budget is spent: fewer samples than the `--spp` cap, a valid
+/// image that says how many it reached, exit 0; resuming it under a new budget goes on.
+#[test]
+fn a_time_budget_stops_early_with_a_valid_image_that_resumes() {
+    let d = temp_dir("time");
+    let cbox = common::asset("cornell-box.gltf");
+    let (exr, resumed, stats) = (d.join("a.exr"), d.join("b.exr"), d.join("stats.json"));
+    let cap = 1_000_000u32;
+    let cap_s = cap.to_string();
+    let run = |args: &[&str]| {
+        let r = veach(args, &[]);
+        let stderr = String::from_utf8_lossy(&r.stderr).to_string();
+        assert_eq!(r.status.code(), Some(0), "{stderr}");
+        let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+        (s, stderr)
+    };
+    let (s, stderr) = run(&[
+        "render",
+        cbox.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp",
+        &cap_s,
+        "--time",
+        "0.5",
+        "--backend",
+        "cpu",
+        "--stats-json",
+        stats.to_str().unwrap(),
+    ]);
+    let spp = s["spp"].as_u64().unwrap() as u32;
+    assert!(spp >= 1 && spp < cap, "{s}");
+    assert_eq!((s["stopped_by"].as_str(), s["interrupted"].as_bool()), (Some("time"), Some(false)), "{s}");
+    assert_eq!(s["spp_target"], cap);
+    assert!(stderr.contains(&format!("{spp} spp (the time budget")), "{stderr}");
+    let (film, job) = veach::output::read_film(&exr).expect("a valid EXR");
+    assert_eq!((film.samples(), job.spp()), (spp, cap));
+    assert!(film.to_rgb32f().iter().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(film.to_rgb32f().iter().any(|v| *v > 0.0), "the image is lit");
+
+    let (s, _) = run(&[
+        "render",
+        "--resume",
+        exr.to_str().unwrap(),
+        "-o",
+        resumed.to_str().unwrap(),
+        "--time",
+        "0.3",
+        "--backend",
+        "cpu",
+        "--stats-json",
+        stats.to_str().unwrap(),
+    ]);
+    let (film, _) = veach::output::read_film(&resumed).expect("a valid EXR");
+    assert!(film.samples() > spp && film.samples() < cap, "{} after {spp}", film.samples());
+    assert_eq!(s["spp"], film.samples());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Firefly clamping is biased on purpose: the EXR's job and --stats-json say so, resume keeps
+/// it, and a limit that is not a positive number is refused in one line.
+#[test]
+fn clamping_is_recorded_in_the_exr_and_the_stats() {
+    let d = temp_dir("clamp");
+    let cbox = common::asset("cornell-box.gltf");
+    let (exr, stats) = (d.join("a.exr"), d.join("stats.json"));
+    let mut args = vec![
+        "render",
+        cbox.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "2",
+        "--backend",
+        "cpu",
+        "--stats-json",
+        stats.to_str().unwrap(),
+    ];
+    for bad in ["0", "-1", "inf", "x"] {
+        let mut a = args.clone();
+        a.extend(["--clamp-direct", bad]);
+        assert_user_error(&veach(&a, &[]), "--clamp-direct");
+    }
+    args.extend(["--clamp-direct", "4", "--clamp-indirect", "1.5"]);
+    let r = veach(&args, &[]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!(
+        (s["biased"].as_bool(), s["clamp_direct"].as_f64(), s["clamp_indirect"].as_f64()),
+        (Some(true), Some(4.0), Some(1.5))
+    );
+    let (_, job) = veach::output::read_film(&exr).expect("a veach EXR");
+    assert_eq!((job.settings.clamp_direct, job.settings.clamp_indirect), (Some(4.0), Some(1.5)));
     let _ = std::fs::remove_dir_all(&d);
 }
 

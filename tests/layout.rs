@@ -112,7 +112,11 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
                 tree_base,
                 trail_base,
                 separate_punctuals,
-                pad
+                clamp_direct,
+                clamp_indirect,
+                pad0,
+                pad1,
+                pad2
             }),
         ),
         ("Triangle", rust_layout!(Triangle { p0, material, e1, light_pdf_area, e2, flags })),

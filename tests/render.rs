@@ -188,3 +188,56 @@ fn same_seed_same_bytes_gpu() {
     assert_eq!(first, second);
     assert_ne!(first.1, other.1);
 }
+
+/// The glass Cornell box (caustics: fireflies) at one sample per pixel, so that each pixel
+/// holds one path's estimate, with the given firefly limits.
+fn clamped(
+    direct: Option<f32>,
+    indirect: Option<f32>,
+    max_depth: u32,
+    seed: u32,
+    ctx: Option<veach::gpu::GpuContext>,
+) -> veach::Film {
+    let s = veach::Settings { clamp_direct: direct, clamp_indirect: indirect, ..settings(48, max_depth, seed) };
+    render(&asset("cornell-glass.gltf"), &s, 1, ctx)
+}
+
+/// Firefly clamping caps every contribution by its kind and only ever removes light. A path
+/// of 8 segments adds at most 4 contributions of direct light (an emitter or the sky seen by
+/// the camera ray, next-event estimates at the first vertex, an emitter hit by its BSDF ray)
+/// and 18 of indirect light (3 per later vertex), so one sample's R+G+B is at most
+/// 4·direct + 18·indirect; the same seed traces the same paths, so no pixel gets brighter.
+#[test]
+fn clamping_bounds_every_contribution_and_only_removes_light() {
+    let sum = |v: Vec3| v.x + v.y + v.z;
+    let (direct, indirect) = (0.01f32, 0.004f32);
+    let bound = (4.0 * direct + 18.0 * indirect) * (1.0 + 1e-4);
+    for seed in 0..2 {
+        let free = clamped(None, None, 8, seed, None);
+        let n = free.pixel_count();
+        let over = (0..n).filter(|&i| sum(free.mean(i)) > bound).count();
+        assert!(over > n / 10, "the limits must bind: only {over} of {n} pixels exceed {bound}");
+        let c = clamped(Some(direct), Some(indirect), 8, seed, None);
+        for i in 0..n {
+            assert!(sum(c.mean(i)) <= bound, "pixel {i}: {} above {bound}", c.mean(i));
+            assert!(c.mean(i).cmple(free.mean(i) * (1.0 + 1e-5) + 1e-6).all(), "pixel {i} gained light");
+        }
+        // Limits above every contribution change nothing, bit for bit.
+        assert_eq!(clamped(Some(1e30), Some(1e30), 8, seed, None).to_rgb32f(), free.to_rgb32f());
+        // Direct light only (2 segments): the indirect limit has no effect, the direct one
+        // bounds the 3 direct contributions of a path.
+        let d2 = clamped(None, None, 2, seed, None);
+        assert_eq!(clamped(None, Some(1e-3), 2, seed, None).to_rgb32f(), d2.to_rgb32f());
+        let c2 = clamped(Some(direct), None, 2, seed, None);
+        assert!((0..n).all(|i| sum(c2.mean(i)) <= 3.0 * direct * (1.0 + 1e-4)));
+        assert!((0..n).any(|i| sum(d2.mean(i)) > 3.0 * direct), "the direct limit must bind");
+    }
+    if let Some(ctx) = gpu("clamping_bounds_every_contribution_and_only_removes_light") {
+        let c = clamped(Some(direct), Some(indirect), 8, 0, Some(ctx));
+        let free = clamped(None, None, 8, 0, gpu("clamping_bounds_every_contribution_and_only_removes_light"));
+        for i in 0..c.pixel_count() {
+            assert!(sum(c.mean(i)) <= bound, "gpu pixel {i}: {} above {bound}", c.mean(i));
+            assert!(c.mean(i).cmple(free.mean(i) * (1.0 + 1e-5) + 1e-6).all(), "gpu pixel {i} gained light");
+        }
+    }
+}

@@ -59,6 +59,15 @@ pub fn unoccluded(scene: &PackedScene, origin: Vec3, ls: &LightSample) -> bool {
     !occluded(scene, &Ray { origin, dir: target - origin }, 1.0)
 }
 
+/// Twin of `clamp_contribution`: firefly control, a contribution carried by a path of
+/// `segments` segments scaled so that its components sum to at most the limit of its kind
+/// (direct light: seen directly or after one bounce).
+pub fn clamp_contribution(params: &Params, c: Vec3, segments: u32) -> Vec3 {
+    let limit = if segments <= 2 { params.clamp_direct } else { params.clamp_indirect };
+    let sum = c.x + c.y + c.z;
+    if sum > limit { c * (limit / sum) } else { c }
+}
+
 pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut Sampler) -> Vec3 {
     let strategy = Strategy::try_from(params.strategy).unwrap_or(Strategy::MisPower);
     let mut radiance = Vec3::ZERO;
@@ -81,7 +90,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
                     _ => w = mis_weight(strategy, prev_pdf, environment_pdf(scene, params, ray.dir)),
                 }
             }
-            radiance += beta * environment_radiance(scene, params, ray.dir) * w;
+            radiance += clamp_contribution(params, beta * environment_radiance(scene, params, ray.dir) * w, depth);
             break;
         }
         let tri = &world_triangle(scene, hit.tri, hit.instance);
@@ -113,7 +122,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
                     }
                 }
             }
-            radiance += beta * emission * w;
+            radiance += clamp_contribution(params, beta * emission * w, depth);
         }
         if params.max_depth != 0 && depth >= params.max_depth {
             break;
@@ -150,13 +159,14 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
                     } else {
                         mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, to_local(&frame, ls.wi), eta))
                     };
-                    radiance += beta * c * (w / ls.pdf);
+                    radiance += clamp_contribution(params, beta * c * (w / ls.pdf), depth + 1);
                 }
             }
         }
         if params.separate_punctuals > 0 {
             let ls = sample_punctual(scene, params, point, sample_1d(sampler));
-            radiance += beta * connect(scene, m, &frame, wo, eta, point, ng, &ls) / ls.pdf.max(1e-30);
+            let c = beta * connect(scene, m, &frame, wo, eta, point, ng, &ls) / ls.pdf.max(1e-30);
+            radiance += clamp_contribution(params, c, depth + 1);
         }
 
         let u0 = sample_1d(sampler);

@@ -210,9 +210,14 @@ pub struct RenderArgs {
     /// (linear f32 RGB, plus the film and the job so that it can be resumed or merged).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Samples per pixel.
+    /// Samples per pixel (with --time: the most to render).
     #[arg(long, conflicts_with = "resume", default_value_t = 64)]
     pub spp: u32,
+    /// Render for this many seconds of render time (loading and writing excluded), then
+    /// write the image with the samples reached; --spp caps them. With --resume: this
+    /// session's budget.
+    #[arg(long, value_parser = parse_budget)]
+    pub time: Option<f64>,
     #[arg(long, conflicts_with = "resume", default_value_t = 512)]
     pub width: u32,
     #[arg(long, conflicts_with = "resume", default_value_t = 512)]
@@ -243,6 +248,15 @@ pub struct RenderArgs {
     pub backend: Backend,
     #[command(flatten)]
     pub look: LookArgs,
+    /// Firefly control (biased, off by default): scale each sample's direct-light
+    /// contribution (emitters seen directly or after one bounce) so that its R+G+B is at
+    /// most C, as Cycles' Clamp Direct. Recorded in the EXR's job and in --stats-json.
+    #[arg(long, value_name = "C", conflicts_with = "resume", value_parser = parse_positive, allow_negative_numbers = true)]
+    pub clamp_direct: Option<f32>,
+    /// The same limit for indirect light (paths of two bounces or more), as Cycles' Clamp
+    /// Indirect.
+    #[arg(long, value_name = "C", conflicts_with = "resume", value_parser = parse_positive, allow_negative_numbers = true)]
+    pub clamp_indirect: Option<f32>,
     /// Render only sample indices START..END (a render-farm split; overrides --spp). Random
     /// numbers are keyed by sample index, so parts merge (`veach merge`) into the full render.
     #[arg(long, conflicts_with = "resume", value_parser = parse_range)]
@@ -323,6 +337,12 @@ pub fn parse_positive(s: &str) -> Result<f32, String> {
 pub fn parse_seconds(s: &str) -> Result<f64, String> {
     let v: f64 = s.trim().parse().map_err(|e| format!("'{s}': {e}"))?;
     if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(format!("{v}: expected a finite number of seconds ≥ 0")) }
+}
+
+/// A time budget: finite and > 0 seconds.
+pub fn parse_budget(s: &str) -> Result<f64, String> {
+    let v: f64 = s.trim().parse().map_err(|e| format!("'{s}': {e}"))?;
+    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(format!("{v}: expected a finite number of seconds > 0")) }
 }
 
 impl LookArgs {

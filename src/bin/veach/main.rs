@@ -36,7 +36,20 @@ fn main() -> ExitCode {
         let at = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
         eprintln!("veach: internal error{at}: {msg} (please report it)");
     }));
-    let cli = args::Cli::parse();
+    let cli = match args::Cli::try_parse() {
+        Ok(cli) => cli,
+        // Help and version go to stdout as clap prints them; a bad flag is one line, exit 2.
+        Err(e) if !e.use_stderr() => e.exit(),
+        Err(e) => {
+            let text = e.render().to_string();
+            // clap's message is its first paragraph (a missing flag is named on the next line).
+            let message: Vec<&str> =
+                text.lines().map(str::trim).skip_while(|l| l.is_empty()).take_while(|l| !l.is_empty()).collect();
+            let message = message.join(" ");
+            eprintln!("veach: {} (--help lists the flags)", message.trim_start_matches("error: "));
+            return ExitCode::from(2);
+        }
+    };
     let done = |r: Result<(), Error>| r.map(|_| Outcome::Done);
     let result = match cli.command {
         args::Command::Render(a) => render::run(&a),

@@ -6,7 +6,7 @@ use crate::args::RenderArgs;
 use glam::Vec3;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use veach::{Budget, Control, Error, Job, Settings, Tile};
 
 /// Set by SIGINT/SIGTERM: finish the chunk in flight, save, exit 130.
@@ -37,6 +37,8 @@ fn job_of(args: &RenderArgs) -> Result<(Job, Option<veach::Film>), Error> {
         strategy: args.strategy,
         sampler: args.sampler,
         tile: args.tile,
+        clamp_direct: args.clamp_direct,
+        clamp_indirect: args.clamp_indirect,
         ..Settings::default()
     };
     args.look.apply(&mut settings);
@@ -85,15 +87,24 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     }
 
     let bar = indicatif::ProgressBar::new(total as u64);
+    // Under a time budget the samples' ETA says nothing: the message shows the time left.
+    let template = if args.time.is_some() {
+        "{elapsed_precise} {wide_bar} {pos}/{len} spp  {msg}"
+    } else {
+        "{elapsed_precise} {wide_bar} {pos}/{len} spp  {msg}  ETA {eta}"
+    };
     bar.set_style(
-        indicatif::ProgressStyle::with_template("{elapsed_precise} {wide_bar} {pos}/{len} spp  {msg}  ETA {eta}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        indicatif::ProgressStyle::with_template(template).unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     bar.set_position(done as u64);
     let pixels = window.width as f64 * window.height as f64;
     let first = done;
     let mut last_checkpoint = Instant::now();
-    let budget = Budget { time: None, cancel: Some(&INTERRUPTED), stop_at_powers_of_two: reference.is_some() };
+    let budget = Budget {
+        time: args.time.map(Duration::from_secs_f64),
+        cancel: Some(&INTERRUPTED),
+        stop_at_powers_of_two: reference.is_some(),
+    };
     let progress =
         veach::render_progressive(&mut renderer, job.sample_start, done, total, budget, &mut |renderer, p| {
             if let Some(r) = &reference
@@ -107,7 +118,12 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             }
             bar.set_position(p.done as u64);
             let rate = (p.done - first) as f64 * pixels / p.seconds.max(1e-9);
-            bar.set_message(format!("{:.2} Msamples/s", rate / 1e6));
+            match args.time {
+                Some(t) => {
+                    bar.set_message(format!("{:.2} Msamples/s  {:.0} s left", rate / 1e6, (t - p.seconds).max(0.0)))
+                }
+                None => bar.set_message(format!("{:.2} Msamples/s", rate / 1e6)),
+            }
             if let Some(path) = &args.checkpoint
                 && last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every
                 && !p.finished()
@@ -118,7 +134,15 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             Ok(Control::Continue)
         })?;
     let done = progress.done;
-    let interrupted = done < total;
+    // Short of the target: the budget ran out (a finished render) or a signal came (saved, exit 130).
+    let interrupted = done < total && INTERRUPTED.load(Ordering::SeqCst);
+    let stopped_by = if done >= total {
+        "samples"
+    } else if interrupted {
+        "interrupt"
+    } else {
+        "time"
+    };
     let film = renderer.film()?;
     let seconds_render = progress.seconds;
     bar.finish_and_clear();
@@ -135,12 +159,13 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     if interrupted {
         eprintln!("veach: interrupted: wrote {} with {done} of {total} spp", args.output.display());
     } else {
+        let spp =
+            if done < total { format!("{done} spp (the time budget; cap {total})") } else { format!("{done} spp") };
         eprintln!(
-            "veach: wrote {} ({}x{}, {} spp, {}, {:.2} s, {:.2} Msamples/s)",
+            "veach: wrote {} ({}x{}, {spp}, {}, {:.2} s, {:.2} Msamples/s)",
             args.output.display(),
             window.width,
             window.height,
-            total,
             renderer.adapter_name(),
             seconds_render,
             samples_per_second / 1e6
@@ -157,11 +182,16 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             "spp_target": total,
             "sample_start": job.sample_start,
             "interrupted": interrupted,
+            "stopped_by": stopped_by,
+            "time_budget": args.time,
             "max_depth": s.max_depth,
             "seed": s.seed,
             "strategy": s.strategy,
             "sampler": s.sampler,
             "light_sampler": s.light_sampler,
+            "clamp_direct": s.clamp_direct,
+            "clamp_indirect": s.clamp_indirect,
+            "biased": s.biased(),
             "light_tree_nodes": light_tree.0,
             "light_tree_depth": light_tree.1,
             "light_tree_build_seconds": light_tree.2,
