@@ -54,4 +54,6 @@ pub use packed::PackedScene;
 pub use render_loop::{Budget, CHUNK_SECONDS, Control, MAX_CHUNK, Progress, render_progressive};
 pub use renderer::{ROW_BAND, Renderer};
 pub use scene::{Camera, Environment, EnvironmentMap, Scene};
-pub use settings::{Backend, LightSampler, MAX_FILM_BYTES, MAX_IMAGE_SIDE, SamplerKind, Settings, Strategy, Tile};
+pub use settings::{
+    Backend, EnvironmentSource, LightSampler, MAX_FILM_BYTES, MAX_IMAGE_SIDE, SamplerKind, Settings, Strategy, Tile,
+};

@@ -5,7 +5,7 @@ use crate::film::Film;
 use crate::packed::PackedScene;
 use crate::params::Params;
 use crate::scene::{Camera, Environment};
-use crate::settings::{Backend, Settings, Tile};
+use crate::settings::{Backend, EnvironmentSource, Settings, Tile};
 use crate::{Error, accel, cpu, gpu};
 
 /// The render parameters of `settings` for `camera`, with the lens set up.
@@ -30,6 +30,7 @@ pub struct Renderer {
     params: Params,
     settings: Settings,
     engine: Engine,
+    environment_source: EnvironmentSource,
 }
 
 impl Renderer {
@@ -89,14 +90,15 @@ impl Renderer {
                 accel::MAX_DEPTH
             )));
         }
-        let environment = settings.environment(&scene.scene_environment)?;
+        let environment_source = settings.environment_source(&scene.scene_environment, scene.has_lights());
+        let environment = settings.environment(&scene.scene_environment, scene.has_lights())?;
         scene.set_environment(&environment);
         let params = make_params(&scene, camera, settings, settings.window());
         let engine = match ctx {
             None => Engine::Cpu(Box::new(cpu::Renderer::new(scene, params))),
             Some(ctx) => Engine::Gpu(Box::new(gpu::GpuRenderer::new(ctx, &scene, params)?), Box::new(scene)),
         };
-        Ok(Renderer { params, settings: settings.clone(), engine })
+        Ok(Renderer { params, settings: settings.clone(), engine, environment_source })
     }
 
     pub fn backend(&self) -> Backend {
@@ -129,6 +131,12 @@ impl Renderer {
 
     pub fn settings(&self) -> &Settings {
         &self.settings
+    }
+
+    /// Where the environment in use comes from (the default studio lights scenes without
+    /// lights).
+    pub fn environment_source(&self) -> EnvironmentSource {
+        self.environment_source
     }
 
     /// Bytes of device memory held (0 on the CPU engine).
@@ -205,6 +213,7 @@ impl Renderer {
                 c.reset(self.params);
             }
         }
+        self.environment_source = EnvironmentSource::Settings;
         Ok(())
     }
 

@@ -92,6 +92,30 @@ pub enum Backend {
     Cpu,
 }
 
+/// Where a render's environment comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EnvironmentSource {
+    /// `env_map` or `env_color` (the command line's `--env`, `--env-color`), or one set by
+    /// `Renderer::set_environment`; `env_color` 0,0,0 keeps a scene without lights black.
+    Settings,
+    /// The scene's own (its glTF extras), or none when the scene has lights of its own.
+    Scene,
+    /// The default studio (`assets/studio.hdr`): the scene has no light of any kind.
+    Studio,
+}
+
+impl EnvironmentSource {
+    /// How the command line and the viewer say it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            EnvironmentSource::Settings => "as given",
+            EnvironmentSource::Scene => "the scene's",
+            EnvironmentSource::Studio => "the default studio (the scene has no lights)",
+        }
+    }
+}
+
 /// A crop window of the image (the whole image by default).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Tile {
@@ -248,16 +272,36 @@ impl Settings {
         Ok(())
     }
 
+    /// Where the environment comes from over a scene whose own is `scene` and which has
+    /// (`scene_has_lights`) or has not an emissive surface or punctual light.
+    pub fn environment_source(&self, scene: &crate::scene::Environment, scene_has_lights: bool) -> EnvironmentSource {
+        if self.env_map.is_some() || self.env_color.is_some() {
+            EnvironmentSource::Settings
+        } else if scene_has_lights || !scene.is_black() {
+            EnvironmentSource::Scene
+        } else {
+            EnvironmentSource::Studio
+        }
+    }
+
     /// The environment these settings ask for over a scene whose own is `scene`: a map
-    /// (loaded here) tinted by the color, a color, or the scene's, each scaled by the strength.
-    pub fn environment(&self, scene: &crate::scene::Environment) -> Result<crate::scene::Environment, Error> {
+    /// (loaded here) tinted by the color, a color, the scene's, or the studio when the scene
+    /// has no light of any kind; each scaled by the strength.
+    pub fn environment(
+        &self,
+        scene: &crate::scene::Environment,
+        scene_has_lights: bool,
+    ) -> Result<crate::scene::Environment, Error> {
         let color = self.env_color.map(Vec3::from);
-        let mut env = match &self.env_map {
-            Some(path) => crate::scene::Environment {
+        let mut env = match (&self.env_map, self.environment_source(scene, scene_has_lights)) {
+            (Some(path), _) => crate::scene::Environment {
                 map: Some(std::sync::Arc::new(crate::scene::EnvironmentMap::load(path)?)),
                 radiance: color.unwrap_or(Vec3::ONE),
             },
-            None => crate::scene::Environment { map: scene.map.clone(), radiance: color.unwrap_or(scene.radiance) },
+            (None, EnvironmentSource::Studio) => crate::scene::Environment::studio(),
+            (None, _) => {
+                crate::scene::Environment { map: scene.map.clone(), radiance: color.unwrap_or(scene.radiance) }
+            }
         };
         env.radiance *= self.env_strength;
         Ok(env)

@@ -116,6 +116,7 @@ fn renders_png_and_exr_with_stats() {
             assert!(s.get(key).is_some(), "stats lack {key}: {s}");
         }
         assert_eq!(s["triangles"], 32);
+        assert_eq!(s["environment"], "scene", "the Cornell box has a lamp: no default studio");
         assert_eq!(s["backend"], "cpu");
     }
     let _ = std::fs::remove_dir_all(&d);

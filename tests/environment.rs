@@ -151,3 +151,68 @@ fn a_new_sky_renders_as_a_renderer_built_with_it() {
         assert!(bytes(&swapped) == nodes, "the BVH changed");
     }
 }
+
+/// The stored default studio (`assets/studio.hdr`, what renders use) is its generator's
+/// output to RGBE precision (an 8-bit mantissa: 1 % of the texel), grey, and a studio: its
+/// softboxes are far brighter than the cyclorama around them.
+#[test]
+fn the_stored_studio_is_its_generator_s_output() {
+    use veach::scene::studio::{STUDIO_HEIGHT, STUDIO_WIDTH, generate_studio};
+    let stored = EnvironmentMap::studio();
+    let made = generate_studio(STUDIO_WIDTH, STUDIO_HEIGHT);
+    assert_eq!((stored.width, stored.height), (made.width, made.height));
+    for (i, (a, b)) in stored.texels.iter().zip(&made.texels).enumerate() {
+        let tolerance = 0.01 * a.max(*b).max_element() + 1e-6;
+        assert!((*a - *b).abs().max_element() <= tolerance, "texel {i}: stored {a}, generated {b}");
+        assert!(a.x == a.y && a.y == a.z, "texel {i} is not grey: {a}");
+    }
+    let (lo, hi) = stored.texels.iter().fold((f32::MAX, 0f32), |(lo, hi), t| (lo.min(t.x), hi.max(t.x)));
+    assert!(lo > 0.0 && hi > 20.0 * lo, "radiance spans {lo}..{hi}");
+}
+
+/// A white diffuse quad facing the camera (+Z) and nothing else: a scene with no light of any
+/// kind. By default the studio lights it, and it reads the studio's irradiance on +Z over π,
+/// which the generator sets to 1 (a check of the map's orientation and of its sampling end to
+/// end); `env_color` 0,0,0 keeps it black on purpose.
+#[test]
+fn a_scene_without_lights_is_lit_by_the_studio_unless_asked_for_black() {
+    let dir = std::env::temp_dir().join(format!("veach-studio-{}", std::process::id()));
+    let mut b = common::build::GltfBuilder::new(&dir, "white-quad");
+    b.use_extension("KHR_materials_specular");
+    let white = b.material(serde_json::json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0},
+        "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}},
+    }));
+    let quad =
+        b.mesh(&common::build::MeshData::quad(-1.0, -1.0, 1.0, 1.0, 0.0, common::build::MeshData::UPRIGHT), white);
+    b.node(serde_json::json!({"mesh": quad}));
+    b.camera(0.3, 1.0, [0.0, 0.0, 2.0]);
+    let path = b.write();
+    let (scene, camera) = common::load_pair(&path, None).expect("scene");
+    let s = settings(16, 2, 1);
+    for ctx in [None, gpu("a_scene_without_lights_is_lit_by_the_studio_unless_asked_for_black")] {
+        let mut r = common::renderer(PackedScene::new(&scene), &camera, &s, ctx.clone()).unwrap();
+        assert_eq!(r.environment_source(), veach::EnvironmentSource::Studio);
+        r.render_samples(0, 256).unwrap();
+        let film = r.film().unwrap();
+        let n = film.pixel_count();
+        let mean = (0..n).map(|i| film.mean(i)).sum::<Vec3>() / n as f32;
+        assert!((mean - Vec3::ONE).abs().max_element() < 0.02, "the white quad reads {mean}, expected 1");
+
+        let black = veach::Settings { env_color: Some([0.0; 3]), ..s.clone() };
+        let mut r = common::renderer(PackedScene::new(&scene), &camera, &black, ctx).unwrap();
+        assert_eq!(r.environment_source(), veach::EnvironmentSource::Settings);
+        r.render_samples(0, 4).unwrap();
+        assert!(r.film().unwrap().to_rgb32f().iter().all(|v| *v == 0.0), "asked for black");
+    }
+    // A scene with lights of its own keeps its (black) environment.
+    let r = common::renderer(
+        PackedScene::new(&common::load_pair(&asset("cornell-box.gltf"), None).unwrap().0),
+        &camera,
+        &s,
+        None,
+    )
+    .unwrap();
+    assert_eq!(r.environment_source(), veach::EnvironmentSource::Scene);
+    let _ = std::fs::remove_dir_all(&dir);
+}

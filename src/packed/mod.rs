@@ -238,6 +238,11 @@ impl PackedScene {
         packed
     }
 
+    /// Whether the scene has an emitter of its own: an emissive triangle or a punctual light.
+    pub fn has_lights(&self) -> bool {
+        !self.lights.is_empty() || self.punctual_count > 0
+    }
+
     /// Replaces the environment (map and radiance) without touching geometry: the light-data
     /// buffer is rebuilt, the BVH is not.
     pub fn set_environment(&mut self, environment: &Environment) {

@@ -6,6 +6,7 @@
 pub mod camera;
 pub mod environment;
 pub mod gltf;
+pub mod studio;
 pub mod tangents;
 
 pub use camera::Camera;
@@ -309,6 +310,11 @@ impl Scene {
             }),
             None => Ok(self.cameras.first().cloned().unwrap_or_else(|| Camera::framing(self.bounds()))),
         }
+    }
+
+    /// Whether the scene has an emitter of its own: an emissive triangle or a punctual light.
+    pub fn has_lights(&self) -> bool {
+        self.emissive_triangle_count() > 0 || !self.punctual_lights.is_empty()
     }
 
     pub fn emissive_triangle_count(&self) -> usize {

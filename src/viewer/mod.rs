@@ -83,6 +83,10 @@ struct Viewer {
     env_strength: f32,
     /// The strength the renderer's environment was built with (None: rebuild it).
     env_applied: Option<f32>,
+    /// The environment came from the command line or a dropped map, not the scene.
+    env_given: bool,
+    /// Light scenes without lights by the default studio (the panel switches it off).
+    studio: bool,
     paused: bool,
     target_spp: u32,
     samples: u32,
@@ -138,6 +142,8 @@ impl Viewer {
             tonemap: Tonemap::Aces,
             env_strength: 1.0,
             env_applied: None,
+            env_given: false,
+            studio: true,
             paused: false,
             target_spp: TARGET_SPP,
             samples: 0,
@@ -173,6 +179,7 @@ impl Viewer {
                     // A new sky: the renderer keeps its BVH and geometry.
                     if let Some(scene) = &mut self.scene {
                         scene.environment = crate::Environment::map(map, Vec3::ONE);
+                        self.env_given = true;
                         self.env_applied = None;
                         self.dirty = true;
                     }
@@ -184,6 +191,7 @@ impl Viewer {
         match crate::load(path, None) {
             Ok(crate::Loaded { mut scene, camera, warnings }) => {
                 self.status = warnings.join("; ");
+                self.env_given = self.options.env.is_some() || self.options.env_color.is_some();
                 if let Some(map) = &self.options.env {
                     match crate::scene::EnvironmentMap::load(map) {
                         Ok(m) => {
@@ -211,7 +219,9 @@ impl Viewer {
         }
         let packed = PackedScene::new(&scene);
         let ctx = GpuContext::from_device(self.rs.device.clone(), self.rs.queue.clone(), self.rs.adapter.get_info());
-        self.env_applied = Some(1.0);
+        // The first restart installs `environment()`: the renderer alone cannot tell a sky
+        // made black on purpose from none.
+        self.env_applied = None;
         match Renderer::with_context(packed, &self.orbit.camera(), &self.settings, ctx) {
             Ok(r) => {
                 self.renderer = Some(r);
@@ -223,10 +233,27 @@ impl Viewer {
         }
     }
 
-    /// The scene's environment scaled by the strength slider.
+    /// Where the environment in use comes from.
+    fn environment_source(&self) -> Option<crate::EnvironmentSource> {
+        let scene = self.scene.as_ref()?;
+        Some(if self.env_given {
+            crate::EnvironmentSource::Settings
+        } else if scene.has_lights() || !scene.environment.is_black() {
+            crate::EnvironmentSource::Scene
+        } else {
+            crate::EnvironmentSource::Studio
+        })
+    }
+
+    /// The environment in use (the scene's, the given one, or the default studio when the
+    /// scene has no lights and the panel leaves it on), scaled by the strength slider.
     fn environment(&self) -> Option<crate::Environment> {
-        let env = &self.scene.as_ref()?.environment;
-        Some(crate::Environment { map: env.map.clone(), radiance: env.radiance * self.env_strength })
+        let scene = self.scene.as_ref()?;
+        let env = match self.environment_source()? {
+            crate::EnvironmentSource::Studio if self.studio => crate::Environment::studio(),
+            _ => scene.environment.clone(),
+        };
+        Some(crate::Environment { map: env.map, radiance: env.radiance * self.env_strength })
     }
 
     /// Restart accumulation at the size the image area wants.

@@ -44,6 +44,20 @@ impl Viewer {
         );
         ui.add(egui::Slider::new(&mut self.settings.max_depth, 0..=32).text("max depth (0 = ∞)"));
         ui.add(egui::Slider::new(&mut self.env_strength, 0.0..=10.0).text("environment"));
+        match self.environment_source() {
+            Some(crate::EnvironmentSource::Studio) => {
+                let text = if self.studio { "environment: the default studio" } else { "environment: none" };
+                ui.label(text);
+                if ui.checkbox(&mut self.studio, "studio light (the scene has no lights)").changed() {
+                    self.env_applied = None;
+                    changed = true;
+                }
+            }
+            Some(source) => {
+                ui.label(format!("environment: {}", source.describe()));
+            }
+            None => {}
+        }
         changed |=
             before != (self.settings.strategy, self.settings.light_sampler, self.settings.max_depth, self.env_strength);
         let max_aperture = MAX_APERTURE_EXTENTS * self.extent;

@@ -57,18 +57,16 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     let loaded = veach::load(&job.scene, job.settings.camera.as_deref())?;
     crate::warn_all(&job.scene, &loaded.warnings);
     let triangles = loaded.scene.triangles.len();
-    let environment = job.settings.environment(&loaded.scene.environment)?;
-    if loaded.scene.emissive_triangle_count() == 0 && loaded.scene.punctual_lights.is_empty() && environment.is_black()
-    {
-        eprintln!(
-            "veach: warning: {}: the scene has no lights and no environment; the image will be black",
-            job.scene.display()
-        );
-    }
     let packed = veach::PackedScene::new(&loaded.scene);
     let (bvh_nodes, bvh_depth, bvh_seconds) = (packed.bvh_nodes, packed.bvh_depth, packed.bvh_build_seconds);
     let light_tree = (packed.light_tree_nodes, packed.light_tree_depth, packed.light_tree_seconds);
     let (mut renderer, backend_reason) = crate::open_renderer(packed, &loaded.camera, &job.settings, args.backend)?;
+    if renderer.environment_source() == veach::EnvironmentSource::Studio {
+        eprintln!(
+            "veach: {}: the scene has no lights: lit by the default studio environment (--env-color 0,0,0 keeps it black)",
+            job.scene.display()
+        );
+    }
     let mut done = 0u32;
     if let Some(film) = resumed {
         done = film.samples().min(job.spp());
@@ -189,6 +187,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             "strategy": s.strategy,
             "sampler": s.sampler,
             "light_sampler": s.light_sampler,
+            "environment": renderer.environment_source(),
             "clamp_direct": s.clamp_direct,
             "clamp_indirect": s.clamp_indirect,
             "biased": s.biased(),
