@@ -16,12 +16,21 @@ fn viewer_screenshot_shows_the_render_and_the_panel() {
         eprintln!("skipping viewer_screenshot: needs xvfb-run (apt-get install xvfb xauth) and a Vulkan adapter");
         return;
     }
-    let out = std::env::temp_dir().join(format!("veach-view-{}.png", std::process::id()));
+    // Auto picks the CPU engine on a software adapter (its film uploaded to the window); gpu
+    // forces the kernel, its film displayed in place.
+    for backend in ["auto", "gpu"] {
+        screenshot_shows_the_render_and_the_panel(backend);
+    }
+}
+
+fn screenshot_shows_the_render_and_the_panel(backend: &str) {
+    let out = std::env::temp_dir().join(format!("veach-view-{}-{backend}.png", std::process::id()));
     let scene = common::asset("cornell-box.gltf");
     let status = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1024x768x24", env!("CARGO_BIN_EXE_veach"), "view"])
         .arg(&scene)
         .args(["--screenshot", out.to_str().unwrap(), "--frames", "8", "--window", "640x400", "--render-scale", "0.4"])
+        .args(["--backend", backend])
         .env_remove("WAYLAND_DISPLAY")
         .output()
         .expect("run xvfb-run");
@@ -40,7 +49,12 @@ fn viewer_screenshot_shows_the_render_and_the_panel() {
             green.push(x);
         }
     }
-    assert!(red.len() > 500 && green.len() > 500, "walls visible: {} red, {} green pixels", red.len(), green.len());
+    assert!(
+        red.len() > 500 && green.len() > 500,
+        "{backend}: walls visible: {} red, {} green pixels",
+        red.len(),
+        green.len()
+    );
     let mean = |v: &[u32]| v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
     assert!(mean(&red) < mean(&green), "red wall on the left");
     assert!(mean(&red) > 250.0, "the render sits right of the side panel");

@@ -1,6 +1,7 @@
-//! `veach view`: an egui/eframe window over the same `Renderer`, refining progressively. The
-//! film stays on the GPU: a compute pass (`shaders/display.wgsl`) tone-maps it into the
-//! texture egui draws, so no pixels travel back to the CPU per frame.
+//! `veach view`: an egui/eframe window over the same `Renderer`, refining progressively, on
+//! the faster engine for this machine (`viewer_backend`). A compute pass
+//! (`shaders/display.wgsl`) tone-maps the film into the texture egui draws: the GPU engine's
+//! film in place (no pixels travel back to the CPU), the CPU engine's uploaded each frame.
 
 mod orbit;
 mod panel;
@@ -41,6 +42,9 @@ pub struct ViewOptions {
     pub window: (u32, u32),
     /// Fraction of the image area's pixels rendered when still (lavapipe is slow: 0.5).
     pub render_scale: f32,
+    /// The engine: `Auto` renders on the window's GPU when it is a hardware one, else on
+    /// the CPU engine (its film uploaded to the window each frame).
+    pub backend: crate::Backend,
 }
 
 pub fn run(options: ViewOptions) -> Result<(), Error> {
@@ -71,7 +75,11 @@ struct Viewer {
     scene_path: Option<PathBuf>,
     scene: Option<Scene>,
     renderer: Option<Renderer>,
+    /// The engine in use, and why (the panel shows it).
+    backend: (crate::Backend, String),
     display: Option<Display>,
+    /// The CPU engine's film as the display pass reads it, uploaded each frame.
+    uploaded_film: Option<wgpu::Buffer>,
     /// The display texture as egui knows it, and its size.
     display_id: Option<(egui::TextureId, u32, u32)>,
     orbit: Orbit,
@@ -125,6 +133,7 @@ impl Viewer {
             max_depth: options.max_depth,
             ..Settings::default()
         };
+        let backend = viewer_backend(options.backend, &rs.adapter.get_info());
         let orbit = Orbit { target: Vec3::ZERO, yaw: 0.0, pitch: 0.0, distance: 4.0, yfov: 40f32.to_radians() };
         let mut v = Viewer {
             rs,
@@ -132,7 +141,9 @@ impl Viewer {
             scene_path: None,
             scene: None,
             renderer: None,
+            backend,
             display,
+            uploaded_film: None,
             display_id: None,
             home: orbit.clone(),
             orbit,
@@ -218,11 +229,18 @@ impl Viewer {
             self.home = self.orbit.clone();
         }
         let packed = PackedScene::new(&scene);
-        let ctx = GpuContext::from_device(self.rs.device.clone(), self.rs.queue.clone(), self.rs.adapter.get_info());
         // The first restart installs `environment()`: the renderer alone cannot tell a sky
         // made black on purpose from none.
         self.env_applied = None;
-        match Renderer::with_context(packed, &self.orbit.camera(), &self.settings, ctx) {
+        let built = match self.backend.0 {
+            crate::Backend::Cpu => Renderer::new(packed, &self.orbit.camera(), &self.settings, crate::Backend::Cpu),
+            _ => {
+                let info = self.rs.adapter.get_info();
+                let ctx = GpuContext::from_device(self.rs.device.clone(), self.rs.queue.clone(), info);
+                Renderer::with_context(packed, &self.orbit.camera(), &self.settings, ctx)
+            }
+        };
+        match built {
             Ok(r) => {
                 self.renderer = Some(r);
                 self.scene = Some(scene);
@@ -351,18 +369,12 @@ impl eframe::App for Viewer {
                 }
             }
             if let Some(r) = &self.renderer
-                && let Some(g) = r.gpu()
+                && let Some(film) = film_on_device(r, &self.rs, &mut self.uploaded_film)
             {
                 let (w, h) = (self.settings.width, self.settings.height);
                 let Some(display) = &mut self.display else { return };
-                let (view, new) = display.resolve(
-                    &self.rs.device,
-                    &self.rs.queue,
-                    g.film_buffer(),
-                    (w, h),
-                    self.exposure,
-                    self.tonemap,
-                );
+                let (view, new) =
+                    display.resolve(&self.rs.device, &self.rs.queue, &film, (w, h), self.exposure, self.tonemap);
                 let mut egui_renderer = self.rs.renderer.write();
                 let id = match self.display_id {
                     Some((id, dw, dh)) if !new && (dw, dh) == (w, h) => id,
@@ -415,4 +427,42 @@ impl eframe::App for Viewer {
         }
         ui.ctx().request_repaint();
     }
+}
+
+/// The engine the viewer renders with, and why: as asked, or (`Auto`) the window's GPU when
+/// it is a hardware adapter and the CPU engine when it is a software one (lavapipe runs the
+/// kernel slower than the CPU engine runs its twin; BENCHMARKS.md).
+fn viewer_backend(asked: crate::Backend, adapter: &wgpu::AdapterInfo) -> (crate::Backend, String) {
+    match asked {
+        crate::Backend::Auto if adapter.device_type == wgpu::DeviceType::Cpu => {
+            (crate::Backend::Cpu, format!("auto: {} is a software adapter", adapter.name))
+        }
+        crate::Backend::Auto => (crate::Backend::Gpu, format!("auto: {}", adapter.name)),
+        b => (b, "requested".into()),
+    }
+}
+
+/// The film as a buffer of the window's device: the GPU engine's own, or the CPU engine's
+/// uploaded into `upload` (same layout, 12 words a pixel; a few MB a frame).
+fn film_on_device(
+    r: &Renderer,
+    rs: &egui_wgpu::RenderState,
+    upload: &mut Option<wgpu::Buffer>,
+) -> Option<wgpu::Buffer> {
+    if let Some(g) = r.gpu() {
+        return Some(g.film_buffer().clone());
+    }
+    let film = r.film().ok()?;
+    let bytes: &[u8] = bytemuck::cast_slice(&film.data);
+    if upload.as_ref().is_none_or(|b| b.size() != bytes.len() as u64) {
+        *upload = Some(rs.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("uploaded film"),
+            size: bytes.len() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        }));
+    }
+    let buffer = upload.as_ref()?;
+    rs.queue.write_buffer(buffer, 0, bytes);
+    Some(buffer.clone())
 }

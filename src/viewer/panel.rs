@@ -15,7 +15,8 @@ impl Viewer {
         let mut changed = false;
         ui.heading("veach");
         let adapter = self.renderer.as_ref().map(|r| r.adapter_name()).unwrap_or_else(|| "no scene".into());
-        ui.label(format!("backend: gpu, {adapter}"));
+        let engine = format!("{:?}", self.backend.0).to_lowercase();
+        ui.label(format!("backend: {engine}, {adapter}")).on_hover_text(&self.backend.1);
         ui.label(format!("samples: {} / {}", self.samples, self.target_spp));
         ui.label(format!("{:.2} Msamples/s", self.rate / 1e6));
         ui.label(format!("resolution: {}×{}", self.settings.width, self.settings.height));

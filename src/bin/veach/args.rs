@@ -66,6 +66,10 @@ pub struct ViewArgs {
     /// Fraction of the image area's resolution rendered when the camera is still.
     #[arg(long, default_value_t = 1.0)]
     pub render_scale: f32,
+    /// auto (the window's GPU when it is a hardware adapter, else the CPU engine, its film
+    /// shown in the window), gpu or cpu.
+    #[arg(long, value_enum, default_value_t = Backend::Auto)]
+    pub backend: Backend,
 }
 
 /// The smallest window side the viewer lays out its panel in.

@@ -18,5 +18,6 @@ pub fn run(args: ViewArgs) -> Result<(), Error> {
         env_color: args.env_color,
         window: args.window,
         render_scale: args.render_scale,
+        backend: args.backend,
     })
 }
