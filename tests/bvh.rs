@@ -111,3 +111,21 @@ fn bvh_depth_is_measured_and_bounded() {
         Ok(_) => panic!("a BVH deeper than the stacks was accepted"),
     }
 }
+
+/// Zero-area triangles (glTF nodes scaled to 0 at rest) stay out of the tree: 2000 of them
+/// at one point among a soup made PLOC chain them ~90 levels deep, past the traversal stacks.
+/// Every triangle keeps its place in the packed scene, and hits are what brute force finds.
+#[test]
+fn zero_area_triangles_stay_out_of_the_tree() {
+    let mut rng = Lcg(5);
+    let mut scene = soup(2000, &mut rng);
+    let p = Vec3::splat(3.0);
+    let point = Triangle { positions: [p; 3], normals: [Vec3::Z; 3], material: 0, ..Default::default() };
+    scene.triangles.extend(std::iter::repeat_n(point, 2000));
+    let packed = PackedScene::new(&scene);
+    assert!(packed.bvh_depth <= 8, "depth {}", packed.bvh_depth);
+    let mut order = packed.order.clone();
+    order.sort_unstable();
+    assert!(order.iter().copied().eq(0..4000u32), "every triangle is packed once");
+    check(&scene, 5_000, &mut rng);
+}

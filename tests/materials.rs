@@ -103,6 +103,41 @@ fn emissive_textures_show_upright_in_linear_rgb_with_wrap_and_transform() {
     }
 }
 
+/// KHR_materials_unlit: a surface shows its base color (factor × sRGB texture) whatever the
+/// light: under a bright point light the pixels read the base color itself, textured or not.
+#[test]
+fn unlit_materials_show_their_base_color_whatever_the_light() {
+    let d = dir("unlit");
+    let mut b = GltfBuilder::new(&d, "unlit");
+    b.use_extension("KHR_materials_unlit");
+    let blocks = b.texture(&block_texture(), CLAMP);
+    let unlit = json!({"KHR_materials_unlit": {}});
+    let textured =
+        b.material(json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": blocks}}, "extensions": unlit}));
+    let flat =
+        b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.5, 0.8, 1.0]}, "extensions": unlit}));
+    let left = b.mesh(&MeshData::quad(-2.0, -1.0, 0.0, 1.0, 0.0, MeshData::UPRIGHT), textured);
+    let right = b.mesh(&MeshData::quad(0.0, -1.0, 2.0, 1.0, 0.0, MeshData::UPRIGHT), flat);
+    b.node(json!({"mesh": left}));
+    b.node(json!({"mesh": right}));
+    b.light(json!({"type": "point", "intensity": 200.0, "color": [1, 1, 1]}), json!({"translation": [0.0, 0.0, 1.5]}));
+    camera_for(&mut b, 3.0, 1.0, 2.0);
+    let path = b.write();
+    let loaded = veach::load(&path, None).unwrap();
+    assert!(loaded.warnings.iter().all(|w| !w.contains("unlit")), "{:?}", loaded.warnings);
+    let expect =
+        [((16, 16), Vec3::from(BLOCKS[0].map(srgb_to_linear))), ((48, 48), Vec3::from(BLOCKS[3].map(srgb_to_linear)))];
+    for (backend, film) in render_both(&path, &settings(128, 64, 8), 4, "unlit") {
+        for ((x, y), want) in expect.into_iter().chain([((96, 32), Vec3::new(0.2, 0.5, 0.8))]) {
+            let got = film.mean(y * 128 + x);
+            assert!(
+                (got - want).abs().max_element() < 2e-3 + 2e-3 * want.max_element(),
+                "{backend}: pixel ({x}, {y}) is {got}, expected the base color {want}"
+            );
+        }
+    }
+}
+
 #[test]
 fn alpha_mask_cuts_and_blend_lets_light_through_in_proportion() {
     let d = dir("alpha");

@@ -115,3 +115,49 @@ fn flight_helmet_keeps_its_textures_and_mirrored_tangents() {
     eprintln!("FlightHelmet: {tangent} triangles with tangents, {mirrored} mirrored");
     assert!(mirrored > 0 && mirrored < tangent);
 }
+
+/// VR Gallery: one KHR_materials_unlit material whose base color texture holds baked lighting
+/// (its SOURCE.txt: unlit it should look like the texture; lit it looks wrong and dark). From
+/// inside the room the image is the texture: a bright lamp in the room changes no pixel, and
+/// the image is bright with the baked shading's range of values.
+#[test]
+fn vr_gallery_shows_its_baked_lighting_unlit() {
+    let Some(dir) = models_dir() else { return };
+    let loaded = veach::load(&dir.join("VRGallery/vr-gallery.glb"), None).unwrap();
+    assert!(loaded.warnings.iter().all(|w| !w.contains("unlit")), "{:?}", loaded.warnings);
+    let eye = glam::Vec3::new(0.0, 1.7, 3.5);
+    let camera = veach::Camera {
+        name: "inside".into(),
+        position: eye,
+        forward: glam::Vec3::NEG_Z,
+        up: glam::Vec3::Y,
+        right: glam::Vec3::X,
+        yfov: 70f32.to_radians(),
+    };
+    let render = |scene: &veach::Scene| {
+        let s = Settings { width: 96, height: 64, env_color: Some([0.0; 3]), ..Settings::default() };
+        let mut r = common::renderer(veach::packed::PackedScene::new(scene), &camera, &s, None).unwrap();
+        r.render_samples(0, 4).unwrap();
+        r.film().unwrap()
+    };
+    let mut lamp = loaded.scene.clone();
+    lamp.punctual_lights.push(veach::scene::PunctualLight {
+        kind: veach::scene::PunctualKind::Point,
+        position: eye + glam::Vec3::new(0.0, 0.5, -1.0),
+        direction: glam::Vec3::NEG_Y,
+        intensity: glam::Vec3::splat(100.0),
+        range: f32::INFINITY,
+    });
+    let (film, lit) = (render(&loaded.scene), render(&lamp));
+    let png = std::env::temp_dir().join(format!("veach-vr-gallery-{}.png", std::process::id()));
+    veach::output::write(&film, &png, 0.0, None).unwrap();
+    eprintln!("VR Gallery from inside: {}", png.display());
+    let n = film.pixel_count();
+    let changed = (0..n).filter(|&i| film.mean(i) != lit.mean(i)).count();
+    assert_eq!(changed, 0, "a lamp changed {changed} of {n} pixels: the surfaces are lit");
+    let lum: Vec<f32> = (0..n).map(|i| veach::packed::luminance(film.mean(i))).collect();
+    let mean = lum.iter().sum::<f32>() / n as f32;
+    let (lo, hi) = lum.iter().fold((f32::MAX, 0f32), |(a, b), &l| (a.min(l), b.max(l)));
+    eprintln!("VR Gallery: mean luminance {mean}, range {lo}..{hi}");
+    assert!(mean > 0.1 && hi > 2.0 * lo, "mean {mean}, range {lo}..{hi}");
+}

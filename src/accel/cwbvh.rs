@@ -50,15 +50,25 @@ pub struct Bvh {
     pub depth: u32,
 }
 
-/// Builds the BVH over triangles given by their three vertices.
+/// Builds the BVH over triangles given by their three vertices. Triangles of zero area (no
+/// ray can hit them; glTF files have them where a node is scaled to 0 at rest) stay out of
+/// the tree, after the leaves' triangles in `order`: hundreds at one point made PLOC chain
+/// them 94 levels deep (AnimateAllTheThings).
 pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
     let start = Instant::now();
-    if triangles.is_empty() {
+    let (kept, degenerate): (Vec<u32>, Vec<u32>) = (0..triangles.len() as u32).partition(|&i| {
+        let t = &triangles[i as usize];
+        (t[1] - t[0]).cross(t[2] - t[0]).length_squared() > 0.0
+    });
+    if kept.is_empty() {
         // A root with no children: rays enter it and find nothing.
-        return Bvh { nodes: vec![CwNode::zeroed()], order: Vec::new(), build_seconds: 0.0, depth: 1 };
+        return Bvh { nodes: vec![CwNode::zeroed()], order: degenerate, build_seconds: 0.0, depth: 1 };
     }
-    let tris: Vec<BvhTriangle> =
-        triangles.iter().map(|t| BvhTriangle { v0: t[0].into(), v1: t[1].into(), v2: t[2].into() }).collect();
+    let tris: Vec<BvhTriangle> = kept
+        .iter()
+        .map(|&i| triangles[i as usize])
+        .map(|t| BvhTriangle { v0: t[0].into(), v1: t[1].into(), v2: t[2].into() })
+        .collect();
     let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
     // obvhs's node is our CwNode without the padding (same field order, little-endian bytes).
     let nodes: Vec<CwNode> = bvh
@@ -70,9 +80,10 @@ pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
             node
         })
         .collect();
-    debug_assert_eq!(bvh.primitive_indices.len(), triangles.len());
+    debug_assert_eq!(bvh.primitive_indices.len(), kept.len());
     let depth = depth(&nodes);
-    Bvh { nodes, order: bvh.primitive_indices, build_seconds: start.elapsed().as_secs_f64(), depth }
+    let order = bvh.primitive_indices.iter().map(|&i| kept[i as usize]).chain(degenerate).collect();
+    Bvh { nodes, order, build_seconds: start.elapsed().as_secs_f64(), depth }
 }
 
 /// Levels of the tree under node 0: PLOC bounds no depth, so it is measured, and a renderer

@@ -9,6 +9,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_transmission",
     "KHR_materials_volume",
     "KHR_lights_punctual",
+    "KHR_materials_unlit",
 ];
 
 /// Extensions veach knows and ignores for now; files that merely use them render, with one
@@ -19,7 +20,6 @@ const KNOWN_UNIMPLEMENTED: &[&str] = &[
     "KHR_materials_iridescence",
     "KHR_materials_anisotropy",
     "KHR_materials_dispersion",
-    "KHR_materials_unlit",
     "KHR_materials_variants",
     "KHR_texture_basisu",
     "EXT_texture_webp",

@@ -69,7 +69,7 @@ pub fn convert_material(m: &gltf::Material, image_slot: &[Option<u32>], warnings
     if m.transmission().and_then(|t| t.transmission_texture()).is_some() {
         warnings.push(format!("{name}: transmissionTexture is not supported; using transmissionFactor"));
     }
-    Material {
+    let material = Material {
         // glTF's factors are in [0, 1]; a hostile 1e20 would overflow a path's throughput.
         base_color: sane3(Vec3::new(r, g, b)).min(Vec3::ONE),
         metallic: sane(pbr.metallic_factor(), 0.0, 1.0, 1.0),
@@ -93,6 +93,25 @@ pub fn convert_material(m: &gltf::Material, image_slot: &[Option<u32>], warnings
         emissive_texture,
         normal_texture,
         normal_scale: sane(normal_scale, -100.0, 100.0, 1.0),
+    };
+    if m.extension_value("KHR_materials_unlit").is_some() { unlit(material) } else { material }
+}
+
+/// KHR_materials_unlit: the surface shows its base color (factor × texture) whatever the
+/// light, so it becomes an emitter of that radiance with a black BSDF: it reflects and
+/// transmits nothing, keeps its alpha (the base color texture stays for it), and, being an
+/// emitter, lights the scene as a lamp of its color would. Like every emitter it emits from
+/// its front face.
+fn unlit(m: Material) -> Material {
+    Material {
+        emission: m.base_color,
+        emissive_texture: m.base_color_texture,
+        base_color: Vec3::ZERO,
+        metallic: 0.0,
+        specular_factor: 0.0,
+        transmission: 0.0,
+        normal_texture: None,
+        ..m
     }
 }
 

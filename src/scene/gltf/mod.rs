@@ -69,8 +69,16 @@ pub fn load_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
 }
 
 /// Fills in what glTF lets a file leave out but the gltf crate's schema requires, so that
-/// valid files load: a scene without `nodes` is an empty scene.
+/// valid files load: a scene without `nodes` is an empty scene. Animations are dropped:
+/// veach renders the rest pose, and KHR_animation_pointer's channels (no `node`) would fail
+/// the crate's schema. `extensionsRequired` is dropped once `check_extensions` has accepted
+/// it: the crate's validator refuses every required extension outside its own feature list
+/// (KHR_materials_unlit among them), even the ones veach implements itself.
 fn normalise(raw: &mut serde_json::Value) {
+    if let Some(root) = raw.as_object_mut() {
+        root.remove("animations");
+        root.remove("extensionsRequired");
+    }
     if let Some(scenes) = raw.get_mut("scenes").and_then(|s| s.as_array_mut()) {
         for scene in scenes.iter_mut().filter_map(|s| s.as_object_mut()) {
             scene.entry("nodes").or_insert_with(|| serde_json::json!([]));
