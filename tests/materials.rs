@@ -123,6 +123,10 @@ fn unlit_materials_show_their_base_color_whatever_the_light() {
     b.light(json!({"type": "point", "intensity": 200.0, "color": [1, 1, 1]}), json!({"translation": [0.0, 0.0, 1.5]}));
     camera_for(&mut b, 3.0, 1.0, 2.0);
     let path = b.write();
+    // Required, as exporters mark it: the file loads (the gltf crate alone refuses it).
+    let mut doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    doc["extensionsRequired"] = json!(["KHR_materials_unlit"]);
+    std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
     let loaded = veach::load(&path, None).unwrap();
     assert!(loaded.warnings.iter().all(|w| !w.contains("unlit")), "{:?}", loaded.warnings);
     let expect =
