@@ -22,6 +22,12 @@ fn temp_dir(name: &str) -> PathBuf {
     d
 }
 
+/// `veach render SCENE -o OUT --width N --height N --spp SPP`, to extend with more flags.
+fn render_args<'a>(scene: &'a std::path::Path, out: &'a std::path::Path, side: &'a str, spp: &'a str) -> Vec<&'a str> {
+    let path = |p: &'a std::path::Path| p.to_str().expect("utf-8 path");
+    vec!["render", path(scene), "-o", path(out), "--width", side, "--height", side, "--spp", spp]
+}
+
 fn assert_user_error(out: &Output, needle: &str) {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "stderr: {stderr}");
@@ -257,20 +263,8 @@ fn the_default_backend_is_the_faster_engine() {
     let stats = d.join("stats.json");
     let run = |extra: &[&str]| {
         let out = d.join("a.png");
-        let mut args = vec![
-            "render",
-            cbox.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "--spp",
-            "1",
-            "--stats-json",
-            stats.to_str().unwrap(),
-        ];
+        let mut args = render_args(&cbox, &out, "8", "1");
+        args.extend(["--stats-json", stats.to_str().unwrap()]);
         args.extend(extra);
         let r = veach(&args, &[]);
         let stderr = String::from_utf8_lossy(&r.stderr).to_string();
@@ -320,24 +314,9 @@ fn a_time_budget_stops_early_with_a_valid_image_that_resumes() {
         let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
         (s, stderr)
     };
-    let (s, stderr) = run(&[
-        "render",
-        cbox.to_str().unwrap(),
-        "-o",
-        exr.to_str().unwrap(),
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "--spp",
-        &cap_s,
-        "--time",
-        "0.5",
-        "--backend",
-        "cpu",
-        "--stats-json",
-        stats.to_str().unwrap(),
-    ]);
+    let mut args = render_args(&cbox, &exr, "16", &cap_s);
+    args.extend(["--time", "0.5", "--backend", "cpu", "--stats-json", stats.to_str().unwrap()]);
+    let (s, stderr) = run(&args);
     let spp = s["spp"].as_u64().unwrap() as u32;
     assert!(spp >= 1 && spp < cap, "{s}");
     assert_eq!((s["stopped_by"].as_str(), s["interrupted"].as_bool()), (Some("time"), Some(false)), "{s}");
@@ -367,29 +346,15 @@ fn a_time_budget_stops_early_with_a_valid_image_that_resumes() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-/// Firefly clamping is biased on purpose: the EXR's job and --stats-json say so, resume keeps
-/// it, and a limit that is not a positive number is refused in one line.
+/// Firefly clamping is biased on purpose: the EXR's job (what resume and merge read) and
+/// --stats-json say so, and a limit that is not a positive number is refused in one line.
 #[test]
 fn clamping_is_recorded_in_the_exr_and_the_stats() {
     let d = temp_dir("clamp");
     let cbox = common::asset("cornell-box.gltf");
     let (exr, stats) = (d.join("a.exr"), d.join("stats.json"));
-    let mut args = vec![
-        "render",
-        cbox.to_str().unwrap(),
-        "-o",
-        exr.to_str().unwrap(),
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "--spp",
-        "2",
-        "--backend",
-        "cpu",
-        "--stats-json",
-        stats.to_str().unwrap(),
-    ];
+    let mut args = render_args(&cbox, &exr, "8", "2");
+    args.extend(["--backend", "cpu", "--stats-json", stats.to_str().unwrap()]);
     for bad in ["0", "-1", "inf", "x"] {
         let mut a = args.clone();
         a.extend(["--clamp-direct", bad]);
