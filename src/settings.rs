@@ -106,6 +106,18 @@ pub enum EnvironmentSource {
 }
 
 impl EnvironmentSource {
+    /// The rule, in one place: an environment given by the user wins; else the scene's own,
+    /// unless the scene has no light of any kind (no emitter, no environment): the studio.
+    pub fn choose(given: bool, scene: &crate::scene::Environment, scene_has_lights: bool) -> EnvironmentSource {
+        if given {
+            EnvironmentSource::Settings
+        } else if scene_has_lights || !scene.is_black() {
+            EnvironmentSource::Scene
+        } else {
+            EnvironmentSource::Studio
+        }
+    }
+
     /// How the command line and the viewer say it.
     pub fn describe(self) -> &'static str {
         match self {
@@ -275,13 +287,7 @@ impl Settings {
     /// Where the environment comes from over a scene whose own is `scene` and which has
     /// (`scene_has_lights`) or has not an emissive surface or punctual light.
     pub fn environment_source(&self, scene: &crate::scene::Environment, scene_has_lights: bool) -> EnvironmentSource {
-        if self.env_map.is_some() || self.env_color.is_some() {
-            EnvironmentSource::Settings
-        } else if scene_has_lights || !scene.is_black() {
-            EnvironmentSource::Scene
-        } else {
-            EnvironmentSource::Studio
-        }
+        EnvironmentSource::choose(self.env_map.is_some() || self.env_color.is_some(), scene, scene_has_lights)
     }
 
     /// The environment these settings ask for over a scene whose own is `scene`: a map

@@ -254,13 +254,7 @@ impl Viewer {
     /// Where the environment in use comes from.
     fn environment_source(&self) -> Option<crate::EnvironmentSource> {
         let scene = self.scene.as_ref()?;
-        Some(if self.env_given {
-            crate::EnvironmentSource::Settings
-        } else if scene.has_lights() || !scene.environment.is_black() {
-            crate::EnvironmentSource::Scene
-        } else {
-            crate::EnvironmentSource::Studio
-        })
+        Some(crate::EnvironmentSource::choose(self.env_given, &scene.environment, scene.has_lights()))
     }
 
     /// The environment in use (the scene's, the given one, or the default studio when the

@@ -61,7 +61,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     let (bvh_nodes, bvh_depth, bvh_seconds) = (packed.bvh_nodes, packed.bvh_depth, packed.bvh_build_seconds);
     let light_tree = (packed.light_tree_nodes, packed.light_tree_depth, packed.light_tree_seconds);
     let (mut renderer, backend_reason) = crate::open_renderer(packed, &loaded.camera, &job.settings, args.backend)?;
-    if renderer.environment_source() == veach::EnvironmentSource::Studio {
+    if renderer.environment_source() == veach::EnvironmentSource::Studio && job.settings.env_strength > 0.0 {
         eprintln!(
             "veach: {}: the scene has no lights: lit by the default studio environment (--env-color 0,0,0 keeps it black)",
             job.scene.display()
