@@ -187,9 +187,11 @@ struct Params {
     // at most 2 segments) or indirect light adds to the pixel (f32 max: off).
     clamp_direct: f32,
     clamp_indirect: f32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
+    // Adaptive sampling (adaptive.wgsl): a pixel stops once its error estimate is below the
+    // threshold (0: off), tested after adaptive_min_samples samples, then every adaptive_step.
+    noise_threshold: f32,
+    adaptive_min_samples: u32,
+    adaptive_step: u32,
 }
 
 struct Ray {

@@ -19,6 +19,11 @@ fn film_pixel(gid: vec3<u32>) -> FilmPixel {
     return FilmPixel(row * params.film_width + gid.x, vec2<u32>(gid.x + params.tile_x, row + params.tile_y), inside);
 }
 
+// Σ L of the pixel whose rows start at `base`, in f32. Twin: film_sum in src/film.rs.
+fn film_sum(base: u32) -> vec3<f32> {
+    return vec3<f32>(film[base].xyz) + vec3<f32>(film[base + 1u].xyz) * (1.0 / 4294967296.0);
+}
+
 fn film_add_sample(pixel: u32, l: vec3<f32>) {
     let base = FILM_WORDS * pixel;
     if (!is_finite_vec3(l)) {

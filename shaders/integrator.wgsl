@@ -9,6 +9,7 @@
 #include "lights.wgsl"
 #include "mis.wgsl"
 #include "film.wgsl"
+#include "adaptive.wgsl"
 #include "material.wgsl"
 
 // Do the geometric and the shading normal agree on which side `wi` leaves?
@@ -186,7 +187,15 @@ fn render_sample(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (!at.inside) {
         return;
     }
+    let adaptive = params.noise_threshold > 0.0;
+    if (adaptive && adaptive_converged(at.slot)) {
+        return;
+    }
     var sampler: Sampler;
     let ray = camera_sample(at.pixel, &sampler);
-    film_add_sample(at.slot, li(ray, &sampler));
+    let l = li(ray, &sampler);
+    film_add_sample(at.slot, l);
+    if (adaptive) {
+        adaptive_add_sample(at.slot, l);
+    }
 }

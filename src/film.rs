@@ -8,10 +8,18 @@
 //!
 //! Per pixel, 12 words: `[hi.r, hi.g, hi.b, count, lo.r, lo.g, lo.b, dropped non-finite
 //! samples, Σr² (f32 bits), Σg², Σb², 0]`.
+//!
+//! A film of an adaptive render (`src/adaptive.rs`) appends two regions after the pixels:
+//! per pixel `ADAPTIVE_WORDS` words `[Σr, Σg, Σb of its odd-numbered samples (the half
+//! buffer, f32 bits), 1 if it passed its last convergence test]`, then one word per pixel,
+//! 1 once it has converged (padded to a multiple of 4 words: the kernel reads vec4 rows).
 
 use glam::{DVec3, Vec3};
 
 pub const WORDS_PER_PIXEL: usize = 12;
+
+/// Words per pixel of an adaptive film's half-buffer region.
+pub const ADAPTIVE_WORDS: usize = 4;
 
 /// Largest radiance one sample may add (the largest f32 below 2^31).
 pub const MAX_SAMPLE: f32 = 2147483520.0;
@@ -30,9 +38,84 @@ pub fn to_fixed(x: f32) -> (u32, u32) {
     ((hi as u32), ((c - hi) * 4294967296.0) as u32)
 }
 
+/// Adds one sample to the 12 words of a pixel; non-finite samples are dropped and counted.
+/// Twin of `film_add_sample`.
+pub fn film_add_sample(p: &mut [u32], l: Vec3) {
+    if !l.is_finite() {
+        p[7] = p[7].wrapping_add(1);
+        return;
+    }
+    for c in 0..3 {
+        let (hi, lo) = to_fixed(l[c]);
+        let (sum_lo, carry) = p[4 + c].overflowing_add(lo);
+        p[4 + c] = sum_lo;
+        p[c] = p[c].wrapping_add(hi).wrapping_add(carry as u32);
+        p[8 + c] = (f32::from_bits(p[8 + c]) + l[c] * l[c]).to_bits();
+    }
+    p[3] = p[3].wrapping_add(1);
+}
+
+/// Σ L of a pixel's 12 words in f32, as the kernel computes it (twin of `film_sum`).
+pub fn film_sum(p: &[u32]) -> Vec3 {
+    let ch = |c: usize| p[c] as f32 + p[4 + c] as f32 * (1.0 / 4294967296.0);
+    Vec3::new(ch(0), ch(1), ch(2))
+}
+
 impl Film {
     pub fn new(width: u32, height: u32) -> Film {
-        Film { width, height, data: vec![0; width as usize * height as usize * WORDS_PER_PIXEL] }
+        Film::with_layout(width, height, false)
+    }
+
+    /// An empty film, with the regions of adaptive sampling when `adaptive`.
+    pub fn with_layout(width: u32, height: u32, adaptive: bool) -> Film {
+        let n = width as usize * height as usize;
+        Film { width, height, data: vec![0; Self::words(n, adaptive)] }
+    }
+
+    fn words(pixels: usize, adaptive: bool) -> usize {
+        pixels * WORDS_PER_PIXEL + if adaptive { pixels * ADAPTIVE_WORDS + pixels.next_multiple_of(4) } else { 0 }
+    }
+
+    /// Bytes of a `width`×`height` film.
+    pub fn bytes(width: u32, height: u32, adaptive: bool) -> u64 {
+        Self::words(width as usize * height as usize, adaptive) as u64 * 4
+    }
+
+    /// Whether the film carries adaptive sampling's half buffer and convergence flags.
+    pub fn is_adaptive(&self) -> bool {
+        self.data.len() > self.pixel_count() * WORDS_PER_PIXEL
+    }
+
+    /// Index of pixel `i`'s half-buffer record in `data` (adaptive films).
+    pub fn adaptive_record(&self, i: usize) -> usize {
+        self.pixel_count() * WORDS_PER_PIXEL + i * ADAPTIVE_WORDS
+    }
+
+    /// Index of pixel `i`'s convergence flag in `data` (adaptive films).
+    pub fn converged_flag(&self, i: usize) -> usize {
+        self.pixel_count() * (WORDS_PER_PIXEL + ADAPTIVE_WORDS) + i
+    }
+
+    /// Whether pixel `i` stopped taking samples (false on a film that is not adaptive).
+    pub fn converged(&self, i: usize) -> bool {
+        self.is_adaptive() && self.data[self.converged_flag(i)] != 0
+    }
+
+    /// The fraction of pixels that converged (None: not an adaptive film).
+    pub fn converged_fraction(&self) -> Option<f64> {
+        self.is_adaptive().then(|| {
+            (0..self.pixel_count()).filter(|&i| self.converged(i)).count() as f64 / self.pixel_count().max(1) as f64
+        })
+    }
+
+    /// Samples pixel `i` took (accumulated or dropped).
+    pub fn taken(&self, i: usize) -> u32 {
+        self.count(i).wrapping_add(self.nonfinite(i))
+    }
+
+    /// The mean number of samples a pixel took.
+    pub fn mean_spp(&self) -> f64 {
+        (0..self.pixel_count()).map(|i| self.taken(i) as f64).sum::<f64>() / self.pixel_count().max(1) as f64
     }
 
     pub fn pixel_count(&self) -> usize {
@@ -43,21 +126,9 @@ impl Film {
         &self.data[i * WORDS_PER_PIXEL..(i + 1) * WORDS_PER_PIXEL]
     }
 
-    /// Adds one sample; non-finite samples are dropped and counted. Twin of `film_add_sample`.
+    /// Adds one sample; non-finite samples are dropped and counted.
     pub fn add_sample(&mut self, i: usize, l: Vec3) {
-        let p = &mut self.data[i * WORDS_PER_PIXEL..(i + 1) * WORDS_PER_PIXEL];
-        if !l.is_finite() {
-            p[7] = p[7].wrapping_add(1);
-            return;
-        }
-        for c in 0..3 {
-            let (hi, lo) = to_fixed(l[c]);
-            let (sum_lo, carry) = p[4 + c].overflowing_add(lo);
-            p[4 + c] = sum_lo;
-            p[c] = p[c].wrapping_add(hi).wrapping_add(carry as u32);
-            p[8 + c] = (f32::from_bits(p[8 + c]) + l[c] * l[c]).to_bits();
-        }
-        p[3] = p[3].wrapping_add(1);
+        film_add_sample(&mut self.data[i * WORDS_PER_PIXEL..(i + 1) * WORDS_PER_PIXEL], l);
     }
 
     pub fn count(&self, i: usize) -> u32 {
@@ -113,9 +184,11 @@ impl Film {
         (0..self.pixel_count()).map(|i| self.count(i)).collect()
     }
 
-    /// Samples per pixel taken (accumulated or dropped; the same for every pixel).
+    /// Samples per pixel taken (accumulated or dropped): the same for every pixel, or on an
+    /// adaptive film the most any pixel took (those still sampling).
     pub fn samples(&self) -> u32 {
-        (0..self.pixel_count()).map(|i| self.count(i) + self.nonfinite(i)).min().unwrap_or(0)
+        let taken = (0..self.pixel_count()).map(|i| self.taken(i));
+        if self.is_adaptive() { taken.max() } else { taken.min() }.unwrap_or(0)
     }
 
     pub fn nonfinite_samples(&self) -> u64 {
@@ -125,6 +198,9 @@ impl Film {
     /// Adds a film covering the window at (x, y) of this one, exactly; refuses a window
     /// outside this film.
     pub fn merge_at(&mut self, other: &Film, x: u32, y: u32) -> Result<(), String> {
+        if self.is_adaptive() || other.is_adaptive() {
+            return Err("films of adaptive renders do not merge (each pixel stopped on its own)".into());
+        }
         let tile = crate::Tile { x, y, width: other.width, height: other.height };
         if !tile.fits(self.width, self.height) || other.data.len() != other.pixel_count() * WORDS_PER_PIXEL {
             return Err(format!(

@@ -44,7 +44,8 @@ impl Job {
             return Err(format!("the scene differs ({} vs {})", self.scene.display(), other.scene.display()));
         }
         let (a, b) = (&self.settings, &other.settings);
-        let checks: [(&str, bool); 12] = [
+        let bits = |c: Option<f32>| c.map(f32::to_bits);
+        let checks: [(&str, bool); 16] = [
             ("camera", a.camera == b.camera),
             ("image size", (a.width, a.height) == (b.width, b.height)),
             ("max depth", a.max_depth == b.max_depth),
@@ -56,7 +57,11 @@ impl Job {
             ("environment color", a.env_color == b.env_color),
             ("environment strength", a.env_strength.to_bits() == b.env_strength.to_bits()),
             ("aperture", a.aperture.to_bits() == b.aperture.to_bits()),
-            ("focus distance", a.focus_distance.map(f32::to_bits) == b.focus_distance.map(f32::to_bits)),
+            ("focus distance", bits(a.focus_distance) == bits(b.focus_distance)),
+            ("direct clamp", bits(a.clamp_direct) == bits(b.clamp_direct)),
+            ("indirect clamp", bits(a.clamp_indirect) == bits(b.clamp_indirect)),
+            ("noise threshold", bits(a.noise_threshold) == bits(b.noise_threshold)),
+            ("adaptive min samples", a.adaptive_min_samples() == b.adaptive_min_samples()),
         ];
         match checks.iter().find(|(_, same)| !same) {
             Some((what, _)) => Err(format!("the {what} differs")),
@@ -84,6 +89,13 @@ pub fn merge(parts: &[Part]) -> Result<(Film, Job), Error> {
     let mut merged = Film::new(w, h);
     let mut seen: Vec<(Tile, u32, u32, &Path)> = Vec::new();
     for part in parts {
+        if part.job.settings.adaptive() {
+            return Err(Error::Input(format!(
+                "{}: an adaptive render (--noise-threshold) cannot be merged: each pixel stopped where its \
+                 own samples converged, so parts do not add up to one render; resume it instead (--resume)",
+                part.path.display()
+            )));
+        }
         part.job.validate().map_err(|e| Error::Input(format!("{}: {e}", part.path.display())))?;
         first.job.compatible_with(&part.job).map_err(|e| {
             Error::Input(format!("{}: not a part of the render of {}: {e}", part.path.display(), first.path.display()))

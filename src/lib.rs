@@ -23,6 +23,7 @@
 
 #[doc(hidden)]
 pub mod accel;
+pub mod adaptive;
 #[cfg(feature = "bench")]
 pub mod bench;
 #[doc(hidden)]

@@ -79,6 +79,21 @@ const FILM_CHANNELS: [&str; 8] = [
     "veach.film.nonfinite",
 ];
 
+/// An adaptive render's state (src/adaptive.rs), exact, so that it resumes exactly: the
+/// half buffer (f32 bits), the last test's result and the convergence flag.
+const ADAPTIVE_CHANNELS: [&str; 5] = [
+    "veach.adaptive.half.R",
+    "veach.adaptive.half.G",
+    "veach.adaptive.half.B",
+    "veach.adaptive.passed",
+    "veach.adaptive.converged",
+];
+
+/// Where word `k` of `ADAPTIVE_CHANNELS` of pixel `i` lives in an adaptive film's data.
+fn adaptive_word(film: &Film, k: usize, i: usize) -> usize {
+    if k < crate::film::ADAPTIVE_WORDS { film.adaptive_record(i) + k } else { film.converged_flag(i) }
+}
+
 /// JSON for an EXR text attribute, which holds Latin-1 only: escape the rest.
 fn ascii_json(value: &serde_json::Value) -> String {
     let json = value.to_string();
@@ -107,6 +122,15 @@ fn write_exr(film: &Film, path: &Path, job: Option<&Job>) -> Result<(), Error> {
     for (w, name) in FILM_CHANNELS.iter().enumerate() {
         let words = (0..n).map(|i| film.data[i * WORDS_PER_PIXEL + w]);
         channels.push(AnyChannel::new(*name, FlatSamples::U32(words.collect())));
+    }
+    if film.is_adaptive() {
+        for (k, name) in ADAPTIVE_CHANNELS.iter().enumerate() {
+            let words = (0..n).map(|i| film.data[adaptive_word(film, k, i)]);
+            channels.push(AnyChannel::new(*name, FlatSamples::U32(words.collect())));
+        }
+        // The per-pixel sample counts as an image (the `samples` AOV of adaptive sampling).
+        let samples = (0..n).map(|i| film.taken(i) as f32);
+        channels.push(AnyChannel::new("samples.Y", FlatSamples::F32(samples.collect())));
     }
     let mut attributes = LayerAttributes::named("veach");
     let meta = serde_json::json!({ "samples": film.samples(), "job": job });
@@ -172,13 +196,14 @@ pub fn read_film(path: &Path) -> Result<(Film, Job), crate::Error> {
     if (w, h) != (window.width as usize, window.height as usize) {
         return Err(fail(format!("film is {w}x{h} but its job says {}x{}", window.width, window.height)));
     }
-    let mut film = Film::new(w as u32, h as u32);
-    for (k, name) in FILM_CHANNELS.iter().enumerate() {
+    let adaptive = job.settings.adaptive();
+    let mut film = Film::with_layout(w as u32, h as u32, adaptive);
+    let u32_channel = |name: &str| -> std::result::Result<Vec<u32>, crate::Error> {
         let channel = layer
             .channel_data
             .list
             .iter()
-            .find(|c| c.name == **name)
+            .find(|c| c.name == *name)
             .ok_or_else(|| fail(format!("missing film channel {name}")))?;
         let words: Vec<u32> = match &channel.sample_data {
             FlatSamples::U32(v) => v.clone(),
@@ -187,14 +212,28 @@ pub fn read_film(path: &Path) -> Result<(Film, Job), crate::Error> {
         if words.len() != w * h {
             return Err(fail(format!("film channel {name} has {} samples, expected {}", words.len(), w * h)));
         }
-        for (i, word) in words.into_iter().enumerate() {
+        Ok(words)
+    };
+    for (k, name) in FILM_CHANNELS.iter().enumerate() {
+        for (i, word) in u32_channel(name)?.into_iter().enumerate() {
             film.data[i * WORDS_PER_PIXEL + k] = word;
         }
     }
-    // Every pixel took the same samples, at most the job's: anything else is a damaged file.
+    if adaptive {
+        for (k, name) in ADAPTIVE_CHANNELS.iter().enumerate() {
+            for (i, word) in u32_channel(name)?.into_iter().enumerate() {
+                let at = adaptive_word(&film, k, i);
+                film.data[at] = word;
+            }
+        }
+    }
+    // Every pixel took the same samples, at most the job's (with adaptive sampling: every
+    // pixel still sampling; converged ones took fewer): anything else is a damaged file.
     let counts = |i: usize| film.count(i) as u64 + film.nonfinite(i) as u64;
-    let first = counts(0);
-    if (0..film.pixel_count()).any(|i| counts(i) != first) || first > job.spp() as u64 {
+    let most = (0..film.pixel_count()).map(counts).max().unwrap_or(0);
+    if (0..film.pixel_count()).any(|i| counts(i) != most && !(film.converged(i) && counts(i) < most))
+        || most > job.spp() as u64
+    {
         return Err(fail(format!(
             "the film's sample counts disagree with each other or exceed the job's {} spp",
             job.spp()

@@ -62,9 +62,12 @@ pub struct Params {
     /// own limits (`f32::MAX`: off).
     pub clamp_direct: f32,
     pub clamp_indirect: f32,
-    pub pad0: u32,
-    pub pad1: u32,
-    pub pad2: u32,
+    /// Adaptive sampling (`src/adaptive.rs`): a pixel stops once its error estimate is below
+    /// this (0: off), tested after `adaptive_min_samples` samples and then every
+    /// `adaptive_step`.
+    pub noise_threshold: f32,
+    pub adaptive_min_samples: u32,
+    pub adaptive_step: u32,
 }
 
 /// Russian roulette starts once a path has this many segments.
@@ -129,9 +132,9 @@ impl Params {
             separate_punctuals: if tree { scene.directional_count } else { scene.punctual_count },
             clamp_direct: settings.clamp_direct.unwrap_or(f32::MAX),
             clamp_indirect: settings.clamp_indirect.unwrap_or(f32::MAX),
-            pad0: 0,
-            pad1: 0,
-            pad2: 0,
+            noise_threshold: settings.noise_threshold.unwrap_or(0.0),
+            adaptive_min_samples: settings.adaptive_min_samples(),
+            adaptive_step: crate::adaptive::ADAPTIVE_STEP,
         }
     }
 }

@@ -33,11 +33,14 @@ pub struct Progress {
     pub total: u32,
     /// Render time so far, callbacks excluded.
     pub seconds: f64,
+    /// With adaptive sampling, the fraction of pixels that stopped (the render ends at 1).
+    pub converged: Option<f64>,
 }
 
 impl Progress {
+    /// Every sample taken, or every pixel converged.
     pub fn finished(&self) -> bool {
-        self.done >= self.total
+        self.done >= self.total || self.converged.is_some_and(|c| c >= 1.0)
     }
 }
 
@@ -50,7 +53,8 @@ pub enum Control {
 
 /// Renders sample indices `first + done .. first + total` into `renderer`'s film (which holds
 /// the first `done`), calling `after_chunk` after each chunk; its time is not render time.
-/// Returns where it stopped: all samples, the time budget, a cancel or the callback.
+/// Returns where it stopped: all samples (or every pixel converged), the time budget, a
+/// cancel or the callback.
 pub fn render_progressive(
     renderer: &mut Renderer,
     first: u32,
@@ -64,7 +68,8 @@ pub fn render_progressive(
     }
     let t0 = Instant::now();
     let mut outside = Duration::ZERO;
-    let mut progress = Progress { done: done.min(total), total, seconds: 0.0 };
+    let mut progress =
+        Progress { done: done.min(total), total, seconds: 0.0, converged: renderer.converged_fraction()? };
     let mut chunk = 1u32;
     let cancelled = || budget.cancel.is_some_and(|c| c.load(Ordering::SeqCst));
     let out_of_time = |p: &Progress| budget.time.is_some_and(|t| p.seconds >= t.as_secs_f64());
@@ -76,6 +81,7 @@ pub fn render_progressive(
         let t = Instant::now();
         renderer.render_samples(first + progress.done, n)?;
         progress.done += n;
+        progress.converged = renderer.converged_fraction()?;
         let secs = t.elapsed().as_secs_f64().max(1e-6);
         chunk = ((n as f64 * CHUNK_SECONDS / secs) as u32).clamp(1, MAX_CHUNK);
         progress.seconds = (t0.elapsed() - outside).as_secs_f64();

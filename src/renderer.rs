@@ -184,6 +184,15 @@ impl Renderer {
         }
     }
 
+    /// The fraction of pixels that stopped sampling (None: not an adaptive render). A
+    /// readback of one word a pixel on the GPU.
+    pub fn converged_fraction(&self) -> Result<Option<f64>, Error> {
+        match &self.engine {
+            Engine::Gpu(g, _) => g.converged_fraction(),
+            Engine::Cpu(c) => Ok(c.film().converged_fraction()),
+        }
+    }
+
     /// Restarts accumulation with a new camera and settings (same scene and environment):
     /// the viewer's reset.
     pub fn reset(&mut self, camera: &Camera, settings: &Settings) -> Result<(), Error> {
@@ -239,13 +248,16 @@ impl Renderer {
     /// Replaces the accumulated film (resume); it must match the render window.
     pub fn set_film(&mut self, film: &Film) -> Result<(), Error> {
         let w = self.settings.window();
-        if (film.width, film.height) != (w.width, w.height)
-            || film.data.len() != Film::new(w.width, w.height).data.len()
-        {
+        if (film.width, film.height) != (w.width, w.height) {
             return Err(Error::Input(format!(
                 "a {}x{} film does not fit the {}x{} render window",
                 film.width, film.height, w.width, w.height
             )));
+        }
+        let adaptive = self.settings.adaptive();
+        if film.data.len() != Film::with_layout(w.width, w.height, adaptive).data.len() {
+            let (want, have) = if adaptive { ("an adaptive", "a uniform") } else { ("a uniform", "an adaptive") };
+            return Err(Error::Input(format!("the render is {want} one; the film is of {have} render")));
         }
         match &mut self.engine {
             Engine::Gpu(g, _) => g.upload_film(film),

@@ -199,6 +199,14 @@ pub struct Settings {
     /// The same limit for indirect light (paths of three segments or more).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clamp_indirect: Option<f32>,
+    /// Adaptive sampling (None: off): a pixel stops taking samples once the error estimated
+    /// from two halves of its samples, relative to the square root of its intensity, is below
+    /// this (Cycles' noise threshold; `src/adaptive.rs`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise_threshold: Option<f32>,
+    /// Samples every pixel takes before adaptive sampling tests it (None: `adaptive_min_samples()`'s default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_samples: Option<u32>,
 }
 
 impl Default for Settings {
@@ -220,6 +228,8 @@ impl Default for Settings {
             light_sampler: LightSampler::Tree,
             clamp_direct: None,
             clamp_indirect: None,
+            noise_threshold: None,
+            min_samples: None,
         }
     }
 }
@@ -228,6 +238,18 @@ impl Settings {
     /// Whether the estimate is biased on purpose (firefly clamping).
     pub fn biased(&self) -> bool {
         self.clamp_direct.is_some() || self.clamp_indirect.is_some()
+    }
+
+    /// Whether pixels stop sampling on their own (adaptive sampling).
+    pub fn adaptive(&self) -> bool {
+        self.noise_threshold.is_some()
+    }
+
+    /// Samples each pixel takes before its first convergence test: as set, else
+    /// `adaptive::DEFAULT_MIN_SAMPLES`; rounded up to a whole number of test steps.
+    pub fn adaptive_min_samples(&self) -> u32 {
+        let step = crate::adaptive::ADAPTIVE_STEP;
+        self.min_samples.unwrap_or(crate::adaptive::DEFAULT_MIN_SAMPLES).max(step).next_multiple_of(step)
     }
 
     /// The window rendered: the tile, or the whole image.
@@ -248,7 +270,7 @@ impl Settings {
                 t.x, t.y, t.width, t.height
             )));
         }
-        let film_bytes = t.width as u64 * t.height as u64 * (crate::film::WORDS_PER_PIXEL * 4) as u64;
+        let film_bytes = crate::film::Film::bytes(t.width, t.height, self.adaptive());
         if film_bytes > MAX_FILM_BYTES {
             return Err(Error::Limit(format!(
                 "a {}x{} film needs {film_bytes} bytes, above veach's limit of {MAX_FILM_BYTES} bytes; render tiles (--tile)",
@@ -275,6 +297,16 @@ impl Settings {
             {
                 return Err(Error::Input(format!("{name} {c}: expected a finite limit > 0")));
             }
+        }
+        if let Some(t) = self.noise_threshold
+            && !(t.is_finite() && t > 0.0)
+        {
+            return Err(Error::Input(format!("noise threshold {t}: expected a finite value > 0")));
+        }
+        if let Some(n) = self.min_samples
+            && n > 1 << 20
+        {
+            return Err(Error::Input(format!("min samples {n}: expected at most {}", 1 << 20)));
         }
         if let Some(c) = self.env_color
             && !c.iter().all(|v| v.is_finite() && *v >= 0.0)

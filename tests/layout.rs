@@ -114,9 +114,9 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
                 separate_punctuals,
                 clamp_direct,
                 clamp_indirect,
-                pad0,
-                pad1,
-                pad2
+                noise_threshold,
+                adaptive_min_samples,
+                adaptive_step
             }),
         ),
         ("Triangle", rust_layout!(Triangle { p0, material, e1, light_pdf_area, e2, flags })),
@@ -249,6 +249,7 @@ fn shared_constants_have_the_same_values() {
         ("TONEMAP_AGX", veach::tonemap::Tonemap::Agx as u32 as f64),
         ("TONEMAP_NEUTRAL", veach::tonemap::Tonemap::Neutral as u32 as f64),
         ("FILM_WORDS", (veach::film::WORDS_PER_PIXEL / 4) as f64),
+        ("ADAPTIVE_WORDS", veach::film::ADAPTIVE_WORDS as f64),
         ("MAX_SAMPLE", veach::film::MAX_SAMPLE as f64),
         ("PAGE_ROW_LOG2", veach::gpu::PAGE_ROW_LOG2 as f64),
         ("NO_HIT", veach::cpu::bvh::NO_HIT as f64),

@@ -1,7 +1,8 @@
 //! The CPU engine: the integrator of this folder over the film's pixels with rayon, the twin
 //! of `gpu::GpuRenderer`.
 
-use crate::film::{Film, WORDS_PER_PIXEL};
+use crate::adaptive::{adaptive_add_sample, adaptive_settle, adaptive_test_due};
+use crate::film::{ADAPTIVE_WORDS, Film, WORDS_PER_PIXEL, film_add_sample};
 use crate::packed::PackedScene;
 use crate::params::Params;
 use rayon::prelude::*;
@@ -10,42 +11,112 @@ pub struct Renderer {
     scene: PackedScene,
     params: Params,
     film: Film,
+    /// Samples taken by the pixels still sampling (adaptive sampling's test schedule).
+    taken: u32,
+}
+
+fn empty_film(params: &Params) -> Film {
+    Film::with_layout(params.film_width, params.film_height, params.noise_threshold > 0.0)
+}
+
+/// Samples `samples` of film row `y` into its words `row`; with adaptive sampling, `adaptive`
+/// holds the row's half-buffer records and convergence flags (converged pixels are skipped).
+fn render_row(
+    scene: &PackedScene,
+    base: &Params,
+    samples: std::ops::Range<u32>,
+    y: usize,
+    row: &mut [u32],
+    mut adaptive: Option<(&mut [u32], &[u32])>,
+) {
+    for s in samples {
+        let p = Params { sample_index: s, ..*base };
+        for (x, words) in row.chunks_exact_mut(WORDS_PER_PIXEL).enumerate() {
+            if adaptive.as_ref().is_some_and(|(_, flags)| flags[x] != 0) {
+                continue;
+            }
+            let l = super::render_sample(scene, &p, x as u32, y as u32);
+            film_add_sample(words, l);
+            if let Some((records, _)) = &mut adaptive {
+                adaptive_add_sample(&p, words, &mut records[x * ADAPTIVE_WORDS..(x + 1) * ADAPTIVE_WORDS], l);
+            }
+        }
+    }
 }
 
 impl Renderer {
     pub fn new(scene: PackedScene, params: Params) -> Renderer {
-        let film = Film::new(params.film_width, params.film_height);
-        Renderer { scene, params, film }
+        let film = empty_film(&params);
+        Renderer { scene, params, film, taken: 0 }
     }
 
     pub fn scene(&self) -> &PackedScene {
         &self.scene
     }
 
-    /// Accumulates sample indices `start .. start + count` into the film, row by row in parallel.
+    /// Accumulates sample indices `start .. start + count` into the film, row by row in
+    /// parallel, pausing at each convergence test of adaptive sampling.
     pub fn render_samples(&mut self, start: u32, count: u32) {
-        let (scene, base) = (&self.scene, self.params);
-        let width = base.film_width as usize;
-        self.film.data.par_chunks_mut(width * WORDS_PER_PIXEL).enumerate().for_each(|(y, row)| {
-            let mut row_film = Film { width: base.film_width, height: 1, data: row.to_vec() };
-            for s in start..start + count {
-                let p = Params { sample_index: s, ..base };
-                for x in 0..width {
-                    row_film.add_sample(x, super::render_sample(scene, &p, x as u32, y as u32));
-                }
+        let mut done = 0;
+        while done < count {
+            let mut n = 1;
+            while done + n < count && !adaptive_test_due(&self.params, self.taken + n) {
+                n += 1;
             }
-            row.copy_from_slice(&row_film.data);
-        });
+            self.render_range(start + done, n);
+            done += n;
+            self.after_sample(n);
+        }
     }
 
-    /// Accumulates sample `sample` for film rows `y0 .. y0 + rows`.
+    /// `n` more samples taken by every pixel still sampling: settles a test when one is due.
+    fn after_sample(&mut self, n: u32) {
+        self.taken += n;
+        if adaptive_test_due(&self.params, self.taken) {
+            adaptive_settle(&mut self.film);
+        }
+    }
+
+    fn render_range(&mut self, start: u32, count: u32) {
+        let (scene, base) = (&self.scene, self.params);
+        let width = base.film_width as usize;
+        let pixels = self.film.pixel_count();
+        let (main, extra) = self.film.data.split_at_mut(pixels * WORDS_PER_PIXEL);
+        let rows = main.par_chunks_mut(width * WORDS_PER_PIXEL).enumerate();
+        if extra.is_empty() {
+            rows.for_each(|(y, row)| render_row(scene, &base, start..start + count, y, row, None));
+        } else {
+            let (records, flags) = extra.split_at_mut(pixels * ADAPTIVE_WORDS);
+            let flags: &[u32] = flags;
+            rows.zip(records.par_chunks_mut(width * ADAPTIVE_WORDS)).for_each(|((y, row), rec)| {
+                let flags = &flags[y * width..(y + 1) * width];
+                render_row(scene, &base, start..start + count, y, row, Some((rec, flags)))
+            });
+        }
+    }
+
+    /// Accumulates sample `sample` for film rows `y0 .. y0 + rows`; the last band of a sample
+    /// settles a convergence test when one is due.
     pub fn render_rows(&mut self, sample: u32, y0: u32, rows: u32) {
         let p = Params { sample_index: sample, ..self.params };
         let (w, h) = (p.film_width, p.film_height);
+        let adaptive = self.film.is_adaptive();
         for y in y0..(y0.saturating_add(rows)).min(h) {
             for x in 0..w {
-                self.film.add_sample((y * w + x) as usize, super::render_sample(&self.scene, &p, x, y));
+                let i = (y * w + x) as usize;
+                if self.film.converged(i) {
+                    continue;
+                }
+                let l = super::render_sample(&self.scene, &p, x, y);
+                self.film.add_sample(i, l);
+                if adaptive {
+                    let (words, record) = crate::adaptive::pixel_words(&mut self.film.data, (w * h) as usize, i);
+                    adaptive_add_sample(&p, words, record, l);
+                }
             }
+        }
+        if y0.saturating_add(rows) >= h {
+            self.after_sample(1);
         }
     }
 
@@ -56,11 +127,14 @@ impl Renderer {
     /// New parameters (camera, settings) and an empty film.
     pub fn reset(&mut self, params: Params) {
         self.params = params;
-        self.film = Film::new(params.film_width, params.film_height);
+        self.film = empty_film(&params);
+        self.taken = 0;
     }
 
+    /// Continues from `film` (resume); its layout matches the parameters.
     pub fn set_film(&mut self, film: &Film) {
         self.film = film.clone();
+        self.taken = film.samples();
     }
 
     /// A new environment for the scene; `reset` follows with the parameters made for it.

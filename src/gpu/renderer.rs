@@ -5,6 +5,7 @@ use super::bindings::{self, Geometry, SceneResources};
 use super::film::DeviceFilm;
 use super::{GeometryPlacement, GpuContext, MAX_BATCH, shaders, storage_buffer};
 use crate::Error;
+use crate::adaptive::adaptive_test_due;
 use crate::film::Film;
 use crate::packed::PackedScene;
 use crate::params::Params;
@@ -15,6 +16,8 @@ pub const WORKGROUP_SIDE: u32 = 8;
 pub struct GpuRenderer {
     pub(super) ctx: GpuContext,
     pipeline: wgpu::ComputePipeline,
+    /// Adaptive sampling's `adaptive_settle`, dispatched after each convergence test.
+    settle: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     #[cfg(feature = "bench")]
     pub(super) pipeline_layout: wgpu::PipelineLayout,
@@ -31,6 +34,8 @@ pub struct GpuRenderer {
     film: DeviceFilm,
     stride: u64,
     pub(super) params: Params,
+    /// Samples taken by the pixels still sampling (adaptive sampling's test schedule).
+    taken: u32,
     /// Bytes of device memory held (scene + film).
     pub gpu_bytes: u64,
 }
@@ -88,21 +93,26 @@ impl GpuRenderer {
             immediate_size: 0,
         });
         let constants = scene.features().constants();
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("integrator"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("render_sample"),
-            compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
-            cache: None,
-        });
-        let film = DeviceFilm::new(&ctx, params.film_width, params.film_height)?;
+        let entry = |name: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(name),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(name),
+                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+                cache: None,
+            })
+        };
+        let pipeline = entry("render_sample");
+        let settle = entry("adaptive_settle");
+        let film = DeviceFilm::new(&ctx, params.film_width, params.film_height, params.noise_threshold > 0.0)?;
         let bind_group = bindings::bind_group(device, &layout, &resources, &params_buf, &film.buffer);
         let gpu_bytes = resources.buffer_bytes() + film.buffer.size() + params_buf.size() + texture_bytes + paged_bytes;
         ctx.check()?;
         Ok(GpuRenderer {
             ctx,
             pipeline,
+            settle,
             layout,
             #[cfg(feature = "bench")]
             pipeline_layout,
@@ -118,13 +128,14 @@ impl GpuRenderer {
             film,
             stride,
             params,
+            taken: 0,
             gpu_bytes,
         })
     }
 
     /// A new film for `params`' window and the bind group over it.
     fn new_film(&mut self, params: Params) -> Result<(), Error> {
-        self.film = DeviceFilm::new(&self.ctx, params.film_width, params.film_height)?;
+        self.film = DeviceFilm::new(&self.ctx, params.film_width, params.film_height, params.noise_threshold > 0.0)?;
         self.bind_group =
             bindings::bind_group(&self.ctx.device, &self.layout, &self.scene, &self.params_buf, &self.film.buffer);
         Ok(())
@@ -137,12 +148,16 @@ impl GpuRenderer {
             storage_buffer(&self.ctx.device, "light data", bytemuck::cast_slice(&scene.light_data))?;
         self.new_film(params)?;
         self.params = params;
+        self.taken = 0;
         self.ctx.check()
     }
 
     /// New parameters (camera, settings, window) and an empty film: the viewer's restart.
     pub fn reset(&mut self, params: Params) -> Result<(), Error> {
-        if (params.film_width, params.film_height) != (self.params.film_width, self.params.film_height) {
+        self.taken = 0;
+        let adaptive = params.noise_threshold > 0.0;
+        if (params.film_width, params.film_height, adaptive) != (self.film.width, self.film.height, self.film.adaptive)
+        {
             self.new_film(params)?;
         } else {
             self.film.clear(&self.ctx);
@@ -163,18 +178,25 @@ impl GpuRenderer {
         self.ctx.adapter_name()
     }
 
-    /// Renders sample indices `start .. start + count` (one dispatch each) and waits.
+    /// Renders sample indices `start .. start + count` (one dispatch each, and a settling
+    /// dispatch after each convergence test of adaptive sampling) and waits.
     pub fn render_samples(&mut self, start: u32, count: u32) -> Result<(), Error> {
-        self.dispatch_samples(&self.pipeline, start, count)
+        self.dispatch_samples(&self.pipeline, start, count, Some(self.taken))?;
+        self.taken += count;
+        Ok(())
     }
 
-    /// `count` dispatches of `pipeline` from sample index `start`, in batches of MAX_BATCH.
+    /// `count` dispatches of `pipeline` from sample index `start`, in batches of MAX_BATCH;
+    /// with `taken` (the samples pixels still sampling took before), settles the tests due.
     pub(super) fn dispatch_samples(
         &self,
         pipeline: &wgpu::ComputePipeline,
         start: u32,
         count: u32,
+        taken: Option<u32>,
     ) -> Result<(), Error> {
+        let groups =
+            (self.params.film_width.div_ceil(WORKGROUP_SIDE), self.params.film_height.div_ceil(WORKGROUP_SIDE));
         let mut done = 0;
         while done < count {
             let batch = (count - done).min(MAX_BATCH);
@@ -191,11 +213,14 @@ impl GpuRenderer {
                 pass.set_pipeline(pipeline);
                 for k in 0..batch {
                     pass.set_bind_group(0, &self.bind_group, &[(self.stride * k as u64) as u32]);
-                    pass.dispatch_workgroups(
-                        self.params.film_width.div_ceil(WORKGROUP_SIDE),
-                        self.params.film_height.div_ceil(WORKGROUP_SIDE),
-                        1,
-                    );
+                    pass.dispatch_workgroups(groups.0, groups.1, 1);
+                    if let Some(taken) = taken
+                        && adaptive_test_due(&self.params, taken + done + k + 1)
+                    {
+                        pass.set_pipeline(&self.settle);
+                        pass.dispatch_workgroups(groups.0, groups.1, 1);
+                        pass.set_pipeline(pipeline);
+                    }
                 }
             }
             let index = self.ctx.queue.submit([encoder.finish()]);
@@ -216,14 +241,36 @@ impl GpuRenderer {
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.bind_group, &[0]);
             pass.dispatch_workgroups(self.params.film_width.div_ceil(WORKGROUP_SIDE), rows.div_ceil(WORKGROUP_SIDE), 1);
+            // The last band of a sample settles a convergence test when one is due.
+            if y0 + rows >= self.params.film_height {
+                self.taken += 1;
+                if adaptive_test_due(&self.params, self.taken) {
+                    pass.set_pipeline(&self.settle);
+                    pass.dispatch_workgroups(
+                        self.params.film_width.div_ceil(WORKGROUP_SIDE),
+                        self.params.film_height.div_ceil(WORKGROUP_SIDE),
+                        1,
+                    );
+                }
+            }
         }
         let index = self.ctx.queue.submit([encoder.finish()]);
         self.ctx.wait(index)
     }
 
-    /// Replaces the film on the device (resume).
+    /// Replaces the film on the device (resume); its layout matches the parameters.
     pub fn upload_film(&mut self, film: &Film) {
         self.film.upload(&self.ctx, film);
+        self.taken = film.samples();
+    }
+
+    /// The fraction of pixels that converged (None: not adaptive).
+    pub fn converged_fraction(&self) -> Result<Option<f64>, Error> {
+        if !self.film.adaptive {
+            return Ok(None);
+        }
+        let pixels = (self.film.width as u64 * self.film.height as u64).max(1);
+        Ok(Some(self.film.converged_pixels(&self.ctx)? as f64 / pixels as f64))
     }
 
     pub fn read_film(&self) -> Result<Film, Error> {

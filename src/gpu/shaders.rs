@@ -24,6 +24,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("light_tree.wgsl", include_str!("../../shaders/light_tree.wgsl")),
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
     ("film.wgsl", include_str!("../../shaders/film.wgsl")),
+    ("adaptive.wgsl", include_str!("../../shaders/adaptive.wgsl")),
     ("integrator.wgsl", include_str!("../../shaders/integrator.wgsl")),
     ("trace.wgsl", include_str!("../../shaders/trace.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),

@@ -261,6 +261,16 @@ pub struct RenderArgs {
     /// Indirect.
     #[arg(long, value_name = "C", conflicts_with = "resume", value_parser = parse_positive, allow_negative_numbers = true)]
     pub clamp_indirect: Option<f32>,
+    /// Adaptive sampling (off by default): a pixel stops taking samples once its noise,
+    /// estimated from two halves of its samples relative to the square root of its
+    /// brightness, is below T (Cycles' Noise Threshold; 0.01 is a clean image, 0.1 a
+    /// preview). --spp is the cap. Adaptive renders resume but do not merge.
+    #[arg(long, value_name = "T", conflicts_with = "resume", value_parser = parse_positive, allow_negative_numbers = true)]
+    pub noise_threshold: Option<f32>,
+    /// Samples every pixel takes before adaptive sampling first tests it (rounded up to a
+    /// multiple of 8; default 16).
+    #[arg(long, value_name = "N", requires = "noise_threshold", conflicts_with = "resume")]
+    pub min_samples: Option<u32>,
     /// Render only sample indices START..END (a render-farm split; overrides --spp). Random
     /// numbers are keyed by sample index, so parts merge (`veach merge`) into the full render.
     #[arg(long, conflicts_with = "resume", value_parser = parse_range)]

@@ -39,6 +39,8 @@ fn job_of(args: &RenderArgs) -> Result<(Job, Option<veach::Film>), Error> {
         tile: args.tile,
         clamp_direct: args.clamp_direct,
         clamp_indirect: args.clamp_indirect,
+        noise_threshold: args.noise_threshold,
+        min_samples: args.min_samples,
         ..Settings::default()
     };
     args.look.apply(&mut settings);
@@ -68,8 +70,10 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
         );
     }
     let mut done = 0u32;
+    let mut resumed_mean_spp = 0.0;
     if let Some(film) = resumed {
         done = film.samples().min(job.spp());
+        resumed_mean_spp = film.mean_spp();
         renderer.set_film(&film)?;
     }
     let total = job.spp();
@@ -103,24 +107,30 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
         cancel: Some(&INTERRUPTED),
         stop_at_powers_of_two: reference.is_some(),
     };
-    let progress =
-        veach::render_progressive(&mut renderer, job.sample_start, done, total, budget, &mut |renderer, p| {
+    let progress = veach::render_progressive(
+        &mut renderer,
+        job.sample_start,
+        done,
+        total,
+        budget,
+        &mut |renderer, p| {
             if let Some(r) = &reference
                 && (p.done.is_power_of_two() || p.finished())
             {
                 let film = renderer.film()?;
                 let (rmse, clamped) = (veach::metrics::rmse(&film, r), veach::metrics::rmse_clamped(&film, r));
                 convergence.push(
-                    serde_json::json!({"spp": p.done, "seconds": p.seconds, "rmse": rmse, "rmse_clamped": clamped}),
+                    serde_json::json!({"spp": p.done, "mean_spp": film.mean_spp(), "seconds": p.seconds, "rmse": rmse, "rmse_clamped": clamped}),
                 );
             }
             bar.set_position(p.done as u64);
             let rate = (p.done - first) as f64 * pixels / p.seconds.max(1e-9);
+            let converged = p.converged.map(|c| format!("  {:.1} % converged", 100.0 * c)).unwrap_or_default();
+            let rate =
+                if p.converged.is_some() { format!("{converged}") } else { format!("{:.2} Msamples/s", rate / 1e6) };
             match args.time {
-                Some(t) => {
-                    bar.set_message(format!("{:.2} Msamples/s  {:.0} s left", rate / 1e6, (t - p.seconds).max(0.0)))
-                }
-                None => bar.set_message(format!("{:.2} Msamples/s", rate / 1e6)),
+                Some(t) => bar.set_message(format!("{rate}  {:.0} s left", (t - p.seconds).max(0.0))),
+                None => bar.set_message(rate),
             }
             if let Some(path) = &args.checkpoint
                 && last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every
@@ -130,12 +140,16 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
                 last_checkpoint = Instant::now();
             }
             Ok(Control::Continue)
-        })?;
+        },
+    )?;
     let done = progress.done;
     // Short of the target: the budget ran out (a finished render) or a signal came (saved, exit 130).
-    let interrupted = done < total && INTERRUPTED.load(Ordering::SeqCst);
+    let interrupted = !progress.finished() && INTERRUPTED.load(Ordering::SeqCst);
+    let converged = progress.converged.is_some_and(|c| c >= 1.0);
     let stopped_by = if done >= total {
         "samples"
+    } else if converged {
+        "converged"
     } else if interrupted {
         "interrupt"
     } else {
@@ -152,13 +166,28 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     if nonfinite > 0 {
         eprintln!("veach: warning: dropped {nonfinite} non-finite samples");
     }
-    let rendered = (done - first) as f64 * pixels;
+    // Samples actually taken (adaptive sampling skips converged pixels).
+    let rendered = if film.is_adaptive() {
+        (film.mean_spp() - resumed_mean_spp).max(0.0) * pixels
+    } else {
+        (done - first) as f64 * pixels
+    };
     let samples_per_second = rendered / seconds_render.max(1e-9);
     if interrupted {
         eprintln!("veach: interrupted: wrote {} with {done} of {total} spp", args.output.display());
     } else {
-        let spp =
-            if done < total { format!("{done} spp (the time budget; cap {total})") } else { format!("{done} spp") };
+        let spp = if film.is_adaptive() {
+            format!(
+                "{:.1} spp on average, at most {} of {total}, {:.1} % of pixels converged",
+                film.mean_spp(),
+                film.samples(),
+                100.0 * film.converged_fraction().unwrap_or(0.0)
+            )
+        } else if done < total {
+            format!("{done} spp (the time budget; cap {total})")
+        } else {
+            format!("{done} spp")
+        };
         eprintln!(
             "veach: wrote {} ({}x{}, {spp}, {}, {:.2} s, {:.2} Msamples/s)",
             args.output.display(),
@@ -176,8 +205,12 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             "width": s.width,
             "height": s.height,
             "tile": s.tile,
-            "spp": done,
+            "spp": film.samples(),
             "spp_target": total,
+            "mean_spp": film.mean_spp(),
+            "noise_threshold": s.noise_threshold,
+            "min_samples": s.adaptive().then(|| s.adaptive_min_samples()),
+            "converged_fraction": film.converged_fraction(),
             "sample_start": job.sample_start,
             "interrupted": interrupted,
             "stopped_by": stopped_by,
