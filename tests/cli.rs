@@ -525,3 +525,69 @@ fn bench_reports_renders_and_ray_rates_per_backend() {
         }
     }
 }
+
+/// `--noise-threshold`: the stats report the mean spp and the converged fraction, the EXR a
+/// `samples` layer; a render stopped by its time budget resumes to the very bytes of an
+/// uninterrupted one; every pixel converged ends the render early; adaptive parts do not merge.
+#[test]
+fn adaptive_renders_report_their_samples_resume_exactly_and_refuse_to_merge() {
+    let d = temp_dir("adaptive");
+    let glass = common::asset("cornell-glass.gltf");
+    let (whole, part, resumed, stats) =
+        (d.join("whole.exr"), d.join("part.exr"), d.join("resumed.exr"), d.join("s.json"));
+    let stats_s = stats.to_str().unwrap();
+    let read_stats = || -> serde_json::Value { serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap() };
+    let adaptive = ["--noise-threshold", "0.1", "--backend", "cpu", "--stats-json", stats_s];
+
+    let mut args = render_args(&glass, &whole, "48", "256");
+    args.extend(adaptive);
+    common::cli::ok(veach(&args, &[]));
+    let s = read_stats();
+    let (mean, converged) = (s["mean_spp"].as_f64().unwrap(), s["converged_fraction"].as_f64().unwrap());
+    assert!(mean < 200.0 && (0.1..0.99).contains(&converged), "{s}");
+    assert_eq!((s["spp"].as_u64(), s["stopped_by"].as_str()), (Some(256), Some("samples")), "{s}");
+    let (film, job) = veach::output::read_film(&whole).expect("a valid EXR");
+    assert_eq!(job.settings.noise_threshold, Some(0.1));
+    assert!((film.mean_spp() - mean).abs() < 1e-9);
+    let image = exr::prelude::read_all_flat_layers_from_file(&whole).expect("exr");
+    let samples = image.layer_data[0].channel_data.list.iter().find(|c| c.name.to_string() == "samples.Y");
+    let samples = samples.expect("a samples layer").sample_data.values_as_f32().collect::<Vec<f32>>();
+    assert_eq!(samples, (0..film.pixel_count()).map(|i| film.taken(i) as f32).collect::<Vec<_>>());
+
+    // Stopped early by time, then resumed: the same bytes as the uninterrupted render.
+    let mut args = render_args(&glass, &part, "48", "256");
+    args.extend(adaptive);
+    args.extend(["--time", "0.15"]);
+    common::cli::ok(veach(&args, &[]));
+    assert_eq!(read_stats()["stopped_by"].as_str(), Some("time"), "the budget must stop this render early");
+    common::cli::ok(veach(
+        &["render", "--resume", part.to_str().unwrap(), "-o", resumed.to_str().unwrap(), "--backend", "cpu"],
+        &[],
+    ));
+    assert!(std::fs::read(&whole).unwrap() == std::fs::read(&resumed).unwrap(), "the resumed render differs");
+
+    // A threshold every pixel meets: all stop at the first test, and the render ends there.
+    let mut args = render_args(&glass, &part, "16", "1000");
+    args.extend(["--noise-threshold", "1000", "--min-samples", "24", "--backend", "cpu", "--stats-json", stats_s]);
+    common::cli::ok(veach(&args, &[]));
+    let s = read_stats();
+    assert_eq!(
+        (s["spp"].as_u64(), s["stopped_by"].as_str(), s["mean_spp"].as_f64()),
+        (Some(24), Some("converged"), Some(24.0)),
+        "{s}"
+    );
+
+    let merged = d.join("merged.exr");
+    assert_user_error(
+        &veach(&["merge", whole.to_str().unwrap(), resumed.to_str().unwrap(), "-o", merged.to_str().unwrap()], &[]),
+        "adaptive",
+    );
+    assert!(!merged.exists());
+    let out = d.join("x.png");
+    let mut args = render_args(&glass, &out, "16", "4");
+    args.extend(["--noise-threshold", "-1"]);
+    assert_user_error(&veach(&args, &[]), "noise-threshold");
+    let mut args = render_args(&glass, &out, "16", "4");
+    args.extend(["--min-samples", "8"]);
+    assert_user_error(&veach(&args, &[]), "noise-threshold");
+}

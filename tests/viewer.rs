@@ -21,22 +21,32 @@ fn viewer_screenshot_shows_the_render_and_the_panel() {
     for backend in ["auto", "gpu"] {
         screenshot_shows_the_render_and_the_panel(backend);
     }
+    // The samples heat map replaces the image: no wall colours are left.
+    let img = screenshot("auto", &["--heat-map"]);
+    let green = img.pixels().filter(|p| p.0[1] > 40 && p.0[1] as u32 > 2 * p.0[0] as u32 + 2 * p.0[2] as u32).count();
+    assert!(green < 50, "{green} green-wall pixels in the heat map");
 }
 
-fn screenshot_shows_the_render_and_the_panel(backend: &str) {
-    let out = std::env::temp_dir().join(format!("veach-view-{}-{backend}.png", std::process::id()));
+fn screenshot(backend: &str, extra: &[&str]) -> image::RgbImage {
+    let out = std::env::temp_dir().join(format!("veach-view-{}-{backend}-{}.png", std::process::id(), extra.len()));
     let scene = common::asset("cornell-box.gltf");
     let status = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1024x768x24", env!("CARGO_BIN_EXE_veach"), "view"])
         .arg(&scene)
         .args(["--screenshot", out.to_str().unwrap(), "--frames", "8", "--window", "640x400", "--render-scale", "0.4"])
         .args(["--backend", backend])
+        .args(extra)
         .env_remove("WAYLAND_DISPLAY")
         .output()
         .expect("run xvfb-run");
     assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
     let img = image::open(&out).expect("a screenshot").to_rgb8();
     let _ = std::fs::remove_file(&out);
+    img
+}
+
+fn screenshot_shows_the_render_and_the_panel(backend: &str) {
+    let img = screenshot(backend, &[]);
     assert!(img.width() >= 600 && img.height() >= 380, "{}x{}", img.width(), img.height());
     // Red-wall and green-wall pixels in the image area (right of the panel), red left of green.
     let (mut red, mut green) = (Vec::new(), Vec::new());
@@ -73,21 +83,26 @@ fn viewer_bands_build_the_same_film_as_render() {
     if let Some(ctx) = common::gpu("viewer_bands_build_the_same_film_as_render") {
         backends.push(Some(ctx));
     }
-    for ctx in backends {
+    // Uniform (3 samples), and adaptive (32 samples: the last band of a sample settles the
+    // tests at 16, 24 and 32).
+    let cases = backends.into_iter().flat_map(|ctx| [(ctx.clone(), None, 3), (ctx, Some(0.2), 32)]);
+    for (ctx, noise_threshold, spp) in cases {
         let backend = if ctx.is_some() { veach::Backend::Gpu } else { veach::Backend::Cpu };
-        let s = veach::Settings { width: 40, height: 28, ..common::settings(40, 8, 3) };
+        let s = veach::Settings { width: 40, height: 28, noise_threshold, ..common::settings(40, 8, 3) };
         let packed = veach::packed::PackedScene::new(&scene);
         let mut whole = veach::Renderer::new(packed.clone(), &camera, &s, veach::Backend::Cpu).unwrap();
         if backend == veach::Backend::Gpu {
             whole = common::renderer(packed.clone(), &camera, &s, common::gpu("bands")).unwrap();
         }
-        whole.render_samples(0, 3).unwrap();
+        whole.render_samples(0, spp).unwrap();
         let mut bands = common::renderer(packed, &camera, &s, ctx).unwrap();
-        for sample in 0..3 {
+        for sample in 0..spp {
             for (y0, rows) in [(0, 8), (8, 16), (24, 8)] {
                 bands.render_rows(sample, y0, rows).unwrap();
             }
         }
-        assert!(whole.film().unwrap() == bands.film().unwrap(), "{backend:?}: bands = whole samples");
+        let film = whole.film().unwrap();
+        assert!(noise_threshold.is_none() || film.converged_fraction().is_some_and(|c| c > 0.0 && c < 1.0));
+        assert!(film == bands.film().unwrap(), "{backend:?}, {noise_threshold:?}: bands = whole samples");
     }
 }

@@ -6,6 +6,15 @@ use super::{GpuContext, WORKGROUP_SIDE, shaders};
 use crate::Error;
 use crate::tonemap::Tonemap;
 
+/// How the film is shown.
+#[derive(Clone, Copy, Debug)]
+pub struct Look {
+    pub exposure: f32,
+    pub tonemap: Tonemap,
+    /// > 0: the samples each pixel took, as a heat map up to this count, instead of the image.
+    pub heat_max: u32,
+}
+
 pub struct Display {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -59,7 +68,7 @@ impl Display {
         });
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("display params"),
-            size: 16,
+            size: 32,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -68,16 +77,17 @@ impl Display {
     }
 
     /// Resolves the `w`×`h` film in `film` into the display texture; returns its view and
-    /// whether the texture is new (its size changed), so a window re-registers it.
+    /// whether the texture is new (its size changed), so a window re-registers it. With
+    /// `heat_max` > 0 it shows the samples each pixel took, as a heat map up to that count.
     pub fn resolve(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         film: &wgpu::Buffer,
         (w, h): (u32, u32),
-        exposure: f32,
-        tonemap: Tonemap,
+        look: Look,
     ) -> (&wgpu::TextureView, bool) {
+        let Look { exposure, tonemap, heat_max } = look;
         let stale = self.target.as_ref().is_none_or(|t| (t.2, t.3) != (w, h));
         if stale {
             self.target = None;
@@ -107,7 +117,7 @@ impl Display {
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(view) },
             ],
         });
-        let p = [w, h, tonemap as u32, exposure.exp2().to_bits()];
+        let p = [w, h, tonemap as u32, exposure.exp2().to_bits(), heat_max, 0, 0, 0];
         queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&p));
         let mut encoder = device.create_command_encoder(&Default::default());
         {

@@ -15,7 +15,7 @@ mod trace;
 
 pub use bindings::TABLE as BINDINGS;
 pub use context::{GeometryPlacement, GpuContext, GpuOptions, NO_ADAPTER_HINT, adapter_info, adapters};
-pub use display::Display;
+pub use display::{Display, Look};
 pub use renderer::{GpuRenderer, WORKGROUP_SIDE};
 
 use crate::Error;

@@ -45,7 +45,15 @@ pub struct ViewOptions {
     /// The engine: `Auto` renders on the window's GPU when it is a hardware one, else on
     /// the CPU engine (its film uploaded to the window each frame).
     pub backend: crate::Backend,
+    /// Adaptive sampling's noise threshold (None: every pixel takes every sample).
+    pub noise_threshold: Option<f32>,
+    /// Show the samples each pixel took (a heat map) from the start.
+    pub heat_map: bool,
 }
+
+/// The viewer's default noise threshold: between Cycles' viewport (0.1) and final (0.01)
+/// defaults; on the glass Cornell box half the pixels stop by 600 spp, the walls first.
+pub const NOISE_THRESHOLD: f32 = 0.05;
 
 pub fn run(options: ViewOptions) -> Result<(), Error> {
     let native = eframe::NativeOptions {
@@ -96,6 +104,10 @@ struct Viewer {
     /// Light scenes without lights by the default studio (the panel switches it off).
     studio: bool,
     paused: bool,
+    /// Shows the samples each pixel took (a heat map) instead of the image.
+    heat_map: bool,
+    /// The fraction of pixels that stopped (adaptive sampling), after the last whole sample.
+    converged: Option<f64>,
     target_spp: u32,
     samples: u32,
     /// Next film row of the sample in progress, and rows per dispatch (multiples of 8).
@@ -131,6 +143,7 @@ impl Viewer {
             width: FIRST_FILM_SIDE,
             height: FIRST_FILM_SIDE,
             max_depth: options.max_depth,
+            noise_threshold: options.noise_threshold,
             ..Settings::default()
         };
         let backend = viewer_backend(options.backend, &rs.adapter.get_info());
@@ -156,6 +169,8 @@ impl Viewer {
             env_given: false,
             studio: true,
             paused: false,
+            heat_map: options.heat_map,
+            converged: None,
             target_spp: TARGET_SPP,
             samples: 0,
             row: 0,
@@ -286,6 +301,7 @@ impl Viewer {
             }
         }
         self.samples = 0;
+        self.converged = None;
         self.row = 0;
         self.dirty = false;
     }
@@ -342,7 +358,11 @@ impl eframe::App for Viewer {
                 let (w, h) = (self.settings.width, self.settings.height.next_multiple_of(ROW_BAND));
                 let t = Instant::now();
                 let mut pixels = 0u64;
-                while self.samples < self.target_spp && t.elapsed().as_secs_f64() < FRAME_SECONDS {
+                let all_converged = |c: Option<f64>| c.is_some_and(|c| c >= 1.0);
+                while self.samples < self.target_spp
+                    && !all_converged(self.converged)
+                    && t.elapsed().as_secs_f64() < FRAME_SECONDS
+                {
                     let rows = self.band.min(h - self.row);
                     let t1 = Instant::now();
                     if let Err(e) = r.render_rows(self.samples, self.row, rows) {
@@ -356,6 +376,7 @@ impl eframe::App for Viewer {
                     if self.row >= h {
                         self.row = 0;
                         self.samples += 1;
+                        self.converged = r.converged_fraction().unwrap_or(None);
                     }
                 }
                 if pixels > 0 {
@@ -367,8 +388,9 @@ impl eframe::App for Viewer {
             {
                 let (w, h) = (self.settings.width, self.settings.height);
                 let Some(display) = &mut self.display else { return };
-                let (view, new) =
-                    display.resolve(&self.rs.device, &self.rs.queue, &film, (w, h), self.exposure, self.tonemap);
+                let heat = if self.heat_map { self.samples.max(1) } else { 0 };
+                let look = crate::gpu::Look { exposure: self.exposure, tonemap: self.tonemap, heat_max: heat };
+                let (view, new) = display.resolve(&self.rs.device, &self.rs.queue, &film, (w, h), look);
                 let mut egui_renderer = self.rs.renderer.write();
                 let id = match self.display_id {
                     Some((id, dw, dh)) if !new && (dw, dh) == (w, h) => id,

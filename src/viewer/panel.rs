@@ -18,6 +18,9 @@ impl Viewer {
         let engine = format!("{:?}", self.backend.0).to_lowercase();
         ui.label(format!("backend: {engine}, {adapter}")).on_hover_text(&self.backend.1);
         ui.label(format!("samples: {} / {}", self.samples, self.target_spp));
+        if let Some(c) = self.converged {
+            ui.label(format!("converged: {:.1} % of pixels", 100.0 * c));
+        }
         ui.label(format!("{:.2} Msamples/s", self.rate / 1e6));
         ui.label(format!("resolution: {}×{}", self.settings.width, self.settings.height));
         if let Some(p) = &self.scene_path {
@@ -26,6 +29,18 @@ impl Viewer {
         ui.separator();
         ui.checkbox(&mut self.paused, "pause");
         ui.add(egui::Slider::new(&mut self.target_spp, 1..=65536).logarithmic(true).text("target spp"));
+        let mut adaptive = self.settings.noise_threshold.is_some();
+        let mut threshold = self.settings.noise_threshold.unwrap_or(super::NOISE_THRESHOLD);
+        let hint = "adaptive sampling: a pixel stops once its noise, relative to the square root of its \
+                    brightness, is below the threshold";
+        changed |= ui.checkbox(&mut adaptive, "adaptive sampling").on_hover_text(hint).changed();
+        if adaptive {
+            changed |= ui
+                .add(egui::Slider::new(&mut threshold, 0.002..=0.5).logarithmic(true).text("noise threshold"))
+                .changed();
+        }
+        self.settings.noise_threshold = adaptive.then_some(threshold);
+        ui.checkbox(&mut self.heat_map, "show samples per pixel").on_hover_text("a heat map: dark few, bright many");
         let before = (self.settings.strategy, self.settings.light_sampler, self.settings.max_depth, self.env_strength);
         egui::ComboBox::from_label("strategy").selected_text(format!("{:?}", self.settings.strategy)).show_ui(
             ui,

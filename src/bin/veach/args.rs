@@ -70,6 +70,12 @@ pub struct ViewArgs {
     /// shown in the window), gpu or cpu.
     #[arg(long, value_enum, default_value_t = Backend::Auto)]
     pub backend: Backend,
+    /// Adaptive sampling's noise threshold (see `veach render --help`); 0 turns it off.
+    #[arg(long, value_name = "T", default_value_t = veach::viewer::NOISE_THRESHOLD, value_parser = parse_non_negative)]
+    pub noise_threshold: f32,
+    /// Start showing the samples each pixel took (a heat map) instead of the image.
+    #[arg(long)]
+    pub heat_map: bool,
 }
 
 /// The smallest window side the viewer lays out its panel in.

@@ -125,9 +125,10 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             }
             bar.set_position(p.done as u64);
             let rate = (p.done - first) as f64 * pixels / p.seconds.max(1e-9);
-            let converged = p.converged.map(|c| format!("  {:.1} % converged", 100.0 * c)).unwrap_or_default();
-            let rate =
-                if p.converged.is_some() { format!("{converged}") } else { format!("{:.2} Msamples/s", rate / 1e6) };
+            let rate = match p.converged {
+                Some(c) => format!("{:.1} % of pixels converged", 100.0 * c),
+                None => format!("{:.2} Msamples/s", rate / 1e6),
+            };
             match args.time {
                 Some(t) => bar.set_message(format!("{rate}  {:.0} s left", (t - p.seconds).max(0.0))),
                 None => bar.set_message(rate),

@@ -19,5 +19,7 @@ pub fn run(args: ViewArgs) -> Result<(), Error> {
         window: args.window,
         render_scale: args.render_scale,
         backend: args.backend,
+        heat_map: args.heat_map,
+        noise_threshold: (args.noise_threshold > 0.0).then_some(args.noise_threshold),
     })
 }
