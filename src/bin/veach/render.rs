@@ -144,6 +144,15 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
         },
     )?;
     let done = progress.done;
+    // A render stopped between powers of two (time budget, convergence, interrupt) records
+    // its last state too.
+    if let Some(r) = &reference
+        && convergence.last().and_then(|c| c["spp"].as_u64()) != Some(done as u64)
+    {
+        let film = renderer.film()?;
+        let (rmse, clamped) = (veach::metrics::rmse(&film, r), veach::metrics::rmse_clamped(&film, r));
+        convergence.push(serde_json::json!({"spp": done, "mean_spp": film.mean_spp(), "seconds": progress.seconds, "rmse": rmse, "rmse_clamped": clamped}));
+    }
     // Short of the target: the budget ran out (a finished render) or a signal came (saved, exit 130).
     let interrupted = !progress.finished() && INTERRUPTED.load(Ordering::SeqCst);
     let converged = progress.converged.is_some_and(|c| c >= 1.0);
