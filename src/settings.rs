@@ -249,7 +249,7 @@ impl Settings {
     /// `adaptive::DEFAULT_MIN_SAMPLES`; rounded up to a whole number of test steps.
     pub fn adaptive_min_samples(&self) -> u32 {
         let step = crate::adaptive::ADAPTIVE_STEP;
-        self.min_samples.unwrap_or(crate::adaptive::DEFAULT_MIN_SAMPLES).max(step).next_multiple_of(step)
+        self.min_samples.unwrap_or(crate::adaptive::DEFAULT_MIN_SAMPLES).clamp(step, 1 << 20).next_multiple_of(step)
     }
 
     /// The window rendered: the tile, or the whole image.
