@@ -15,7 +15,7 @@
 //! The tests happen at fixed sample counts and read only the film, so an adaptive render is
 //! deterministic for a seed and resumes exactly from its EXR, whatever the chunking.
 
-use crate::film::{ADAPTIVE_WORDS, Film, WORDS_PER_PIXEL, film_sum};
+use crate::film::{Film, film_sum};
 use crate::params::Params;
 use glam::Vec3;
 
@@ -78,13 +78,6 @@ pub fn adaptive_settle(film: &mut Film) {
         let at = film.converged_flag(i);
         film.data[at] = 1;
     }
-}
-
-/// The words of pixel `i` and its half-buffer record, split out of an adaptive film's data
-/// (for tests and the CPU engine's row loop).
-pub fn pixel_words(data: &mut [u32], pixels: usize, i: usize) -> (&mut [u32], &mut [u32]) {
-    let (main, rest) = data.split_at_mut(pixels * WORDS_PER_PIXEL);
-    (&mut main[i * WORDS_PER_PIXEL..(i + 1) * WORDS_PER_PIXEL], &mut rest[i * ADAPTIVE_WORDS..(i + 1) * ADAPTIVE_WORDS])
 }
 
 #[cfg(test)]

@@ -229,7 +229,7 @@ pub fn read_film(path: &Path) -> Result<(Film, Job), crate::Error> {
     }
     // Every pixel took the same samples, at most the job's (with adaptive sampling: every
     // pixel still sampling; converged ones took fewer): anything else is a damaged file.
-    let counts = |i: usize| film.count(i) as u64 + film.nonfinite(i) as u64;
+    let counts = |i: usize| film.taken(i) as u64;
     let most = (0..film.pixel_count()).map(counts).max().unwrap_or(0);
     if (0..film.pixel_count()).any(|i| counts(i) != most && !(film.converged(i) && counts(i) < most))
         || most > job.spp() as u64

@@ -63,7 +63,7 @@ impl Renderer {
             while done + n < count && !adaptive_test_due(&self.params, self.taken + n) {
                 n += 1;
             }
-            self.render_range(start + done, n);
+            self.render_range(start + done, n, 0..self.params.film_height as usize);
             done += n;
             self.after_sample(n);
         }
@@ -77,18 +77,24 @@ impl Renderer {
         }
     }
 
-    fn render_range(&mut self, start: u32, count: u32) {
+    /// Samples `start .. start + count` of film rows `rows`, rows in parallel.
+    fn render_range(&mut self, start: u32, count: u32, rows: std::ops::Range<usize>) {
         let (scene, base) = (&self.scene, self.params);
         let width = base.film_width as usize;
         let pixels = self.film.pixel_count();
         let (main, extra) = self.film.data.split_at_mut(pixels * WORDS_PER_PIXEL);
-        let rows = main.par_chunks_mut(width * WORDS_PER_PIXEL).enumerate();
+        let (skip, take) = (rows.start, rows.len());
+        let film_rows = main.par_chunks_mut(width * WORDS_PER_PIXEL).enumerate();
         if extra.is_empty() {
-            rows.for_each(|(y, row)| render_row(scene, &base, start..start + count, y, row, None));
+            film_rows
+                .skip(skip)
+                .take(take)
+                .for_each(|(y, row)| render_row(scene, &base, start..start + count, y, row, None));
         } else {
             let (records, flags) = extra.split_at_mut(pixels * ADAPTIVE_WORDS);
             let flags: &[u32] = flags;
-            rows.zip(records.par_chunks_mut(width * ADAPTIVE_WORDS)).for_each(|((y, row), rec)| {
+            let rows = film_rows.zip(records.par_chunks_mut(width * ADAPTIVE_WORDS)).skip(skip).take(take);
+            rows.for_each(|((y, row), rec)| {
                 let flags = &flags[y * width..(y + 1) * width];
                 render_row(scene, &base, start..start + count, y, row, Some((rec, flags)))
             });
@@ -98,23 +104,9 @@ impl Renderer {
     /// Accumulates sample `sample` for film rows `y0 .. y0 + rows`; the last band of a sample
     /// settles a convergence test when one is due.
     pub fn render_rows(&mut self, sample: u32, y0: u32, rows: u32) {
-        let p = Params { sample_index: sample, ..self.params };
-        let (w, h) = (p.film_width, p.film_height);
-        let adaptive = self.film.is_adaptive();
-        for y in y0..(y0.saturating_add(rows)).min(h) {
-            for x in 0..w {
-                let i = (y * w + x) as usize;
-                if self.film.converged(i) {
-                    continue;
-                }
-                let l = super::render_sample(&self.scene, &p, x, y);
-                self.film.add_sample(i, l);
-                if adaptive {
-                    let (words, record) = crate::adaptive::pixel_words(&mut self.film.data, (w * h) as usize, i);
-                    adaptive_add_sample(&p, words, record, l);
-                }
-            }
-        }
+        let h = self.params.film_height;
+        let end = y0.saturating_add(rows).min(h);
+        self.render_range(sample, 1, y0.min(end) as usize..end as usize);
         if y0.saturating_add(rows) >= h {
             self.after_sample(1);
         }

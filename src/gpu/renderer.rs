@@ -214,11 +214,8 @@ impl GpuRenderer {
                 for k in 0..batch {
                     pass.set_bind_group(0, &self.bind_group, &[(self.stride * k as u64) as u32]);
                     pass.dispatch_workgroups(groups.0, groups.1, 1);
-                    if let Some(taken) = taken
-                        && adaptive_test_due(&self.params, taken + done + k + 1)
-                    {
-                        pass.set_pipeline(&self.settle);
-                        pass.dispatch_workgroups(groups.0, groups.1, 1);
+                    if taken.is_some_and(|t| adaptive_test_due(&self.params, t + done + k + 1)) {
+                        self.settle_in(&mut pass);
                         pass.set_pipeline(pipeline);
                     }
                 }
@@ -228,6 +225,16 @@ impl GpuRenderer {
             done += batch;
         }
         Ok(())
+    }
+
+    /// Records adaptive sampling's settling pass over the whole film (the bind group set).
+    fn settle_in(&self, pass: &mut wgpu::ComputePass<'_>) {
+        pass.set_pipeline(&self.settle);
+        pass.dispatch_workgroups(
+            self.params.film_width.div_ceil(WORKGROUP_SIDE),
+            self.params.film_height.div_ceil(WORKGROUP_SIDE),
+            1,
+        );
     }
 
     /// Renders sample `sample` of film rows `y0 .. y0 + rows` only (`y0` and `rows` multiples
@@ -245,12 +252,7 @@ impl GpuRenderer {
             if y0 + rows >= self.params.film_height {
                 self.taken += 1;
                 if adaptive_test_due(&self.params, self.taken) {
-                    pass.set_pipeline(&self.settle);
-                    pass.dispatch_workgroups(
-                        self.params.film_width.div_ceil(WORKGROUP_SIDE),
-                        self.params.film_height.div_ceil(WORKGROUP_SIDE),
-                        1,
-                    );
+                    self.settle_in(&mut pass);
                 }
             }
         }

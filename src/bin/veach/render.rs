@@ -107,21 +107,12 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
         cancel: Some(&INTERRUPTED),
         stop_at_powers_of_two: reference.is_some(),
     };
-    let progress = veach::render_progressive(
-        &mut renderer,
-        job.sample_start,
-        done,
-        total,
-        budget,
-        &mut |renderer, p| {
+    let progress =
+        veach::render_progressive(&mut renderer, job.sample_start, done, total, budget, &mut |renderer, p| {
             if let Some(r) = &reference
                 && (p.done.is_power_of_two() || p.finished())
             {
-                let film = renderer.film()?;
-                let (rmse, clamped) = (veach::metrics::rmse(&film, r), veach::metrics::rmse_clamped(&film, r));
-                convergence.push(
-                    serde_json::json!({"spp": p.done, "mean_spp": film.mean_spp(), "seconds": p.seconds, "rmse": rmse, "rmse_clamped": clamped}),
-                );
+                convergence.push(convergence_entry(&renderer.film()?, r, p.done, p.seconds));
             }
             bar.set_position(p.done as u64);
             let rate = (p.done - first) as f64 * pixels / p.seconds.max(1e-9);
@@ -141,17 +132,14 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
                 last_checkpoint = Instant::now();
             }
             Ok(Control::Continue)
-        },
-    )?;
+        })?;
     let done = progress.done;
     // A render stopped between powers of two (time budget, convergence, interrupt) records
     // its last state too.
     if let Some(r) = &reference
         && convergence.last().and_then(|c| c["spp"].as_u64()) != Some(done as u64)
     {
-        let film = renderer.film()?;
-        let (rmse, clamped) = (veach::metrics::rmse(&film, r), veach::metrics::rmse_clamped(&film, r));
-        convergence.push(serde_json::json!({"spp": done, "mean_spp": film.mean_spp(), "seconds": progress.seconds, "rmse": rmse, "rmse_clamped": clamped}));
+        convergence.push(convergence_entry(&renderer.film()?, r, done, progress.seconds));
     }
     // Short of the target: the budget ran out (a finished render) or a signal came (saved, exit 130).
     let interrupted = !progress.finished() && INTERRUPTED.load(Ordering::SeqCst);
@@ -255,6 +243,12 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
         veach::output::write_atomic(path, serde_json::to_string_pretty(&stats).unwrap_or_default().as_bytes())?;
     }
     Ok(if interrupted { Outcome::Interrupted } else { Outcome::Done })
+}
+
+/// One point of `--reference`'s convergence record.
+fn convergence_entry(film: &veach::Film, reference: &[Vec3], spp: u32, seconds: f64) -> serde_json::Value {
+    let (rmse, clamped) = (veach::metrics::rmse(film, reference), veach::metrics::rmse_clamped(film, reference));
+    serde_json::json!({"spp": spp, "mean_spp": film.mean_spp(), "seconds": seconds, "rmse": rmse, "rmse_clamped": clamped})
 }
 
 /// The reference image for --reference, as linear RGB per pixel of the render window.
