@@ -10,8 +10,8 @@
 #include "common.wgsl"
 #include "sampling.wgsl"
 #include "microfacet.wgsl"
-
-const DELTA_ALPHA: f32 = 1e-4;
+#include "clearcoat.wgsl"
+#include "sheen.wgsl"
 
 struct BsdfSample {
     wi: vec3<f32>,
@@ -73,12 +73,16 @@ fn transmission_albedo(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
 // Probabilities of sampling the specular, diffuse and transmission lobes, from their albedos.
 // A rough interface transmits through some microfacets even beyond the critical angle of the
 // macro surface, so its transmission lobe keeps at least a tenth of its weight.
-fn lobe_probabilities(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
+fn lobe_weights(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
     var wt = luminance(transmission_albedo(m, cos_o, eta));
     if (TRANSMISSION && m.roughness * m.roughness >= DELTA_ALPHA) {
         wt = max(wt, 0.1 * (1.0 - m.metallic) * m.transmission * luminance(m.base_color));
     }
-    let w = vec3<f32>(luminance(bsdf_fresnel(m, cos_o, eta)), luminance(diffuse_albedo(m, cos_o, eta)), wt);
+    return vec3<f32>(luminance(bsdf_fresnel(m, cos_o, eta)), luminance(diffuse_albedo(m, cos_o, eta)), wt);
+}
+
+fn lobe_probabilities(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
+    let w = lobe_weights(m, cos_o, eta);
     let total = w.x + w.y + w.z;
     if (total <= 0.0) {
         return vec3<f32>(0.0);
@@ -116,7 +120,7 @@ fn refract_dir(wo: vec3<f32>, n: vec3<f32>, eta: f32) -> vec4<f32> {
 }
 
 // f(wo, wi) without the cosine; Dirac lobes are not included.
-fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec3<f32> {
+fn base_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec3<f32> {
     let alpha = m.roughness * m.roughness;
     if (wo.z <= 0.0 || wi.z == 0.0) {
         return vec3<f32>(0.0);
@@ -144,7 +148,7 @@ fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec3<f32> {
     return f;
 }
 
-fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> f32 {
+fn base_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> f32 {
     if (wo.z <= 0.0 || wi.z == 0.0) {
         return 0.0;
     }
@@ -169,7 +173,7 @@ fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> f32 {
     return pdf;
 }
 
-fn bsdf_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample {
+fn base_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample {
     let none = BsdfSample(vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(0.0), 0.0, false);
     if (wo.z <= 0.0) {
         return none;
@@ -210,6 +214,119 @@ fn bsdf_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample
         if (wi.z >= 0.0) {
             return none;
         }
+    }
+    let pdf = base_pdf(m, wo, wi, eta);
+    if (wi.z == 0.0 || pdf <= 0.0) {
+        return none;
+    }
+    return BsdfSample(wi, base_eval(m, wo, wi, eta) * (abs(wi.z) / pdf), pdf, false);
+}
+
+// The layers over the base: KHR_materials_clearcoat's coat over KHR_materials_sheen's sheen.
+fn has_layers(m: Material) -> bool {
+    return (CLEARCOAT && m.clearcoat > 0.0) || (SHEEN && max_component(m.sheen_color) > 0.0);
+}
+
+// What reaches the base through the layers: 1 − the coat's weight, times the sheen's albedo
+// scaling (from both directions; a transmitted wi by its |cos|).
+fn base_scaling(m: Material, wo: vec3<f32>, wi: vec3<f32>, coat: f32) -> f32 {
+    if (!SHEEN) {
+        return 1.0 - coat;
+    }
+    return (1.0 - coat) * sheen_albedo_scaling(m.sheen_color, m.sheen_roughness, wo.z, abs(wi.z));
+}
+
+// Probabilities of sampling the coat, the sheen and the base, from their albedos seen from wo.
+fn layer_probabilities(m: Material, wo: vec3<f32>, eta: f32) -> vec3<f32> {
+    let coat = coat_weight(m, wo);
+    var e = 0.0;
+    if (SHEEN && max_component(m.sheen_color) > 0.0) {
+        e = sheen_albedo(wo.z, m.sheen_roughness);
+    }
+    let b = lobe_weights(m, wo.z, eta);
+    let w = vec3<f32>(
+        coat,
+        (1.0 - coat) * luminance(m.sheen_color) * e,
+        (1.0 - coat) * (1.0 - max_component(m.sheen_color) * e) * (b.x + b.y + b.z),
+    );
+    let total = w.x + w.y + w.z;
+    if (total <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    return w / total;
+}
+
+// f(wo, wi) without the cosine: coat + (1 − coat weight) · (sheen + base · sheen scaling).
+// Dirac lobes are not included.
+fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec3<f32> {
+    let base = base_eval(m, wo, wi, eta);
+    if (!has_layers(m)) {
+        return base;
+    }
+    if (wo.z <= 0.0 || wi.z == 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let coat = coat_weight(m, wo);
+    var f = base * base_scaling(m, wo, wi, coat);
+    if (wi.z > 0.0) {
+        if (SHEEN) {
+            f += (1.0 - coat) * m.sheen_color * sheen_brdf(wo, wi, m.sheen_roughness);
+        }
+        f += vec3<f32>(coat * coat_eval(m, wo, wi));
+    }
+    return f;
+}
+
+fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> f32 {
+    if (!has_layers(m)) {
+        return base_pdf(m, wo, wi, eta);
+    }
+    if (wo.z <= 0.0 || wi.z == 0.0) {
+        return 0.0;
+    }
+    let p = layer_probabilities(m, wo, eta);
+    var pdf = p.z * base_pdf(m, wo, wi, eta);
+    if (wi.z > 0.0) {
+        pdf += p.x * coat_pdf(m, wo, wi) + p.y * UNIFORM_HEMISPHERE_PDF;
+    }
+    return pdf;
+}
+
+// Picks the base, the coat or the sheen with u.x, then a direction from it (the base with
+// u.x rescaled to its share). Dirac lobes of the base keep its layers' scaling.
+fn bsdf_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample {
+    if (!has_layers(m)) {
+        return base_sample(m, wo, u, eta);
+    }
+    let none = BsdfSample(vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(0.0), 0.0, false);
+    if (wo.z <= 0.0) {
+        return none;
+    }
+    let p = layer_probabilities(m, wo, eta);
+    var wi: vec3<f32>;
+    if (u.x < p.z) {
+        let s = base_sample(m, wo, vec3<f32>(u.x / p.z, u.y, u.z), eta);
+        if (s.pdf <= 0.0) {
+            return none;
+        }
+        if (s.delta) {
+            let scale = base_scaling(m, wo, s.wi, coat_weight(m, wo));
+            return BsdfSample(s.wi, s.weight * (scale / p.z), s.pdf * p.z, true);
+        }
+        wi = s.wi;
+    } else if (u.x < p.z + p.x) {
+        wi = coat_sample(m, wo, u.yz);
+        if (wi.z <= 0.0) {
+            return none;
+        }
+        if (coat_alpha(m) < DELTA_ALPHA) {
+            return BsdfSample(wi, vec3<f32>(coat_weight(m, wo) / p.x), p.x, true);
+        }
+    } else {
+        if (p.y <= 0.0) {
+            return none;
+        }
+        wi = sample_uniform_hemisphere(u.yz);
     }
     let pdf = bsdf_pdf(m, wo, wi, eta);
     if (wi.z == 0.0 || pdf <= 0.0) {

@@ -18,6 +18,8 @@ override TEXTURES: bool = true;
 override PUNCTUAL_LIGHTS: bool = true;
 override TRANSMISSION: bool = true;
 override INSTANCING: bool = true;
+override CLEARCOAT: bool = true;
+override SHEEN: bool = true;
 
 struct BvhNode {
     min: vec3<f32>,
@@ -103,13 +105,30 @@ struct Material {
     attenuation: vec3<f32>,
     flags: u32,
     normal_scale: f32,
+    // KHR_materials_clearcoat (0: no coat) and KHR_materials_sheen (black: no sheen).
+    clearcoat: f32,
+    clearcoat_roughness: f32,
+    clearcoat_normal_scale: f32,
+    sheen_color: vec3<f32>,
+    sheen_roughness: f32,
+    // The coat's normal in the local shading frame: (0, 0, 1) in the buffer, set per hit.
+    coat_normal: vec3<f32>,
     pad0: f32,
+    // ((ior − 1)/(ior + 1))² × specularColor before clamping, for specular textures.
+    specular_f0: vec3<f32>,
     pad1: f32,
-    pad2: f32,
     base_color_texture: TextureRef,
     metallic_roughness_texture: TextureRef,
     emissive_texture: TextureRef,
     normal_texture: TextureRef,
+    transmission_texture: TextureRef,
+    specular_texture: TextureRef,
+    specular_color_texture: TextureRef,
+    clearcoat_texture: TextureRef,
+    clearcoat_roughness_texture: TextureRef,
+    clearcoat_normal_texture: TextureRef,
+    sheen_color_texture: TextureRef,
+    sheen_roughness_texture: TextureRef,
 }
 
 // KHR_lights_punctual, four rows of the light-data buffer each.
@@ -192,6 +211,11 @@ struct Params {
     noise_threshold: f32,
     adaptive_min_samples: u32,
     adaptive_step: u32,
+    // First row of the sheen albedo table in light_data (sheen.wgsl).
+    sheen_base: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 struct Ray {

@@ -85,7 +85,7 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
         }
         let tri = world_triangle(hit.tri, hit.instance);
         let uv = triangle_uv(hit.tri, hit.u, hit.v);
-        let m = material_at(materials[tri.material], uv);
+        var m = material_at(materials[tri.material], uv);
         let point = tri.p0 + hit.u * tri.e1 + hit.v * tri.e2;
         let ng_cross = normalize(cross(tri.e1, tri.e2));
         let ng_raw = select(ng_cross, -ng_cross, (tri.flags & TRI_MIRRORED) != 0u);
@@ -119,6 +119,13 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
         ns = select(ns, -ns, dot(ns, ray.dir) > 0.0);
         let frame = frame_from_normal(ns);
         let wo = to_local(frame, -ray.dir);
+        // A coat follows its own normal map, or the interpolated normal when the base's is mapped.
+        if (CLEARCOAT && TEXTURES && m.clearcoat > 0.0
+            && (m.normal_texture.layer != NO_TEXTURE || m.clearcoat_normal_texture.layer != NO_TEXTURE)) {
+            var nc = coat_normal(tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, m, uv);
+            nc = select(nc, -nc, dot(nc, ray.dir) > 0.0);
+            m.coat_normal = to_local(frame, nc);
+        }
 
         // Next-event estimation: one light sample. With the BSDF strategy alone it still
         // runs for the tree's Dirac lights, which nothing else can find.

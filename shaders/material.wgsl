@@ -29,6 +29,33 @@ fn material_at(m: Material, uv: vec2<f32>) -> Material {
     if (TEXTURES && m.emissive_texture.layer != NO_TEXTURE) {
         r.emission = m.emission * sample_texture(m.emissive_texture, uv).xyz;
     }
+    if (TEXTURES && TRANSMISSION && m.transmission_texture.layer != NO_TEXTURE) {
+        r.transmission = m.transmission * sample_texture(m.transmission_texture, uv).x;
+    }
+    if (TEXTURES && (m.specular_texture.layer != NO_TEXTURE || m.specular_color_texture.layer != NO_TEXTURE)) {
+        var factor = m.dielectric_f90;
+        var f0 = m.specular_f0;
+        if (m.specular_texture.layer != NO_TEXTURE) {
+            factor *= sample_texture(m.specular_texture, uv).w;
+        }
+        if (m.specular_color_texture.layer != NO_TEXTURE) {
+            f0 *= sample_texture(m.specular_color_texture, uv).xyz;
+        }
+        r.dielectric_f0 = min(f0, vec3<f32>(1.0)) * factor;
+        r.dielectric_f90 = factor;
+    }
+    if (TEXTURES && CLEARCOAT && m.clearcoat_texture.layer != NO_TEXTURE) {
+        r.clearcoat = m.clearcoat * sample_texture(m.clearcoat_texture, uv).x;
+    }
+    if (TEXTURES && CLEARCOAT && m.clearcoat_roughness_texture.layer != NO_TEXTURE) {
+        r.clearcoat_roughness = m.clearcoat_roughness * sample_texture(m.clearcoat_roughness_texture, uv).y;
+    }
+    if (TEXTURES && SHEEN && m.sheen_color_texture.layer != NO_TEXTURE) {
+        r.sheen_color = m.sheen_color * sample_texture(m.sheen_color_texture, uv).xyz;
+    }
+    if (TEXTURES && SHEEN && m.sheen_roughness_texture.layer != NO_TEXTURE) {
+        r.sheen_roughness = m.sheen_roughness * sample_texture(m.sheen_roughness_texture, uv).w;
+    }
     return r;
 }
 
@@ -67,6 +94,20 @@ fn oct_decode(bits: u32) -> vec3<f32> {
 fn shading_normal(
     tri: Triangle, index: u32, instance: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec2<f32>
 ) -> vec3<f32> {
+    return mapped_normal(tri, index, instance, u, v, ng, m.normal_texture, m.normal_scale, uv);
+}
+
+// The clearcoat's normal: its own normal map, else the interpolated normal.
+fn coat_normal(
+    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec2<f32>
+) -> vec3<f32> {
+    return mapped_normal(tri, index, instance, u, v, ng, m.clearcoat_normal_texture, m.clearcoat_normal_scale, uv);
+}
+
+fn mapped_normal(
+    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, ng: vec3<f32>, map: TextureRef, scale: f32,
+    uv: vec2<f32>
+) -> vec3<f32> {
     var n = ng;
     let a = load_attributes(index);
     var inst: Instance;
@@ -81,7 +122,7 @@ fn shading_normal(
         let len2 = dot(s, s);
         n = select(ng, s * inverseSqrt(len2), len2 > 0.0);
     }
-    if (!TEXTURES || (tri.flags & TRI_HAS_TANGENTS) == 0u || m.normal_texture.layer == NO_TEXTURE) {
+    if (!TEXTURES || (tri.flags & TRI_HAS_TANGENTS) == 0u || map.layer == NO_TEXTURE) {
         return n;
     }
     var t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12.x) + v * oct_decode(a.t12.y);
@@ -100,8 +141,8 @@ fn shading_normal(
         w = -w;
     }
     let b = cross(n, t) * w;
-    let c = sample_texture(m.normal_texture, uv).xyz * 2.0 - 1.0;
-    let mapped = t * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + n * c.z;
+    let c = sample_texture(map, uv).xyz * 2.0 - 1.0;
+    let mapped = t * (c.x * scale) + b * (c.y * scale) + n * c.z;
     let mlen2 = dot(mapped, mapped);
     return select(n, mapped * inverseSqrt(mlen2), mlen2 > 1e-12);
 }

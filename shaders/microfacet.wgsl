@@ -3,6 +3,9 @@
 // Twin: src/cpu/microfacet.rs.
 #include "common.wgsl"
 
+// Below this α a GGX lobe is a Dirac lobe (mirror, smooth glass).
+const DELTA_ALPHA: f32 = 1e-4;
+
 // D(h) = α² / (π (cos²θ (α² − 1) + 1)²), with the denominator written as α² cos²θ + sin²θ:
 // the textbook form cancels to 0 when α² is below f32's epsilon (roughness < 0.016), making
 // D infinite and the sample NaN.

@@ -12,6 +12,14 @@ fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
     return max(cos_theta, 0.0) * INV_PI;
 }
 
+fn sample_uniform_hemisphere(u: vec2<f32>) -> vec3<f32> {
+    let r = sqrt(max(0.0, 1.0 - u.x * u.x));
+    let phi = 2.0 * PI * u.y;
+    return vec3<f32>(r * cos(phi), r * sin(phi), u.x);
+}
+
+const UNIFORM_HEMISPHERE_PDF: f32 = 0.15915494309189535;
+
 fn sample_uniform_sphere(u: vec2<f32>) -> vec3<f32> {
     let z = 1.0 - 2.0 * u.x;
     let r = sqrt(max(0.0, 1.0 - z * z));

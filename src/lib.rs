@@ -43,6 +43,8 @@ mod render_loop;
 mod renderer;
 pub mod scene;
 mod settings;
+#[doc(hidden)]
+pub mod sheen;
 pub mod tonemap;
 #[cfg(feature = "viewer")]
 pub mod viewer;

@@ -68,6 +68,9 @@ pub struct Params {
     pub noise_threshold: f32,
     pub adaptive_min_samples: u32,
     pub adaptive_step: u32,
+    /// First row of the sheen albedo table in the light-data buffer (`src/sheen.rs`).
+    pub sheen_base: u32,
+    pub pad: [u32; 3],
 }
 
 /// Russian roulette starts once a path has this many segments.
@@ -135,6 +138,8 @@ impl Params {
             noise_threshold: settings.noise_threshold.unwrap_or(0.0),
             adaptive_min_samples: settings.adaptive_min_samples(),
             adaptive_step: crate::adaptive::ADAPTIVE_STEP,
+            sheen_base: scene.sheen_base,
+            pad: [0; 3],
         }
     }
 }

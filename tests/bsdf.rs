@@ -2,7 +2,9 @@
 //! over the sphere, as pbrt and Mitsuba test theirs), and `eval·cos/pdf` averages to the
 //! albedo a quadrature of `eval·cos` gives. Rough glass (KHR_materials_transmission) is
 //! tested from both sides, entering (η = 1.5) and leaving (η = 1/1.5, with total internal
-//! reflection).
+//! reflection). The layers over the base — KHR_materials_clearcoat's coat (with a coat
+//! normal of its own) and KHR_materials_sheen's sheen — are tested alone, together and over
+//! metal, plastic and glass.
 
 mod common;
 
@@ -25,6 +27,22 @@ fn material(base: f32, metallic: f32, roughness: f32, specular: f32) -> PackedMa
     })
 }
 
+/// A coat of strength 1 and this roughness over `base`, its normal tilted by `tilt` (radians).
+fn coated(base: Material, roughness: f32, tilt: f32) -> PackedMaterial {
+    let mut m = pack_material(&Material { clearcoat: 1.0, clearcoat_roughness: roughness, ..base });
+    m.coat_normal = [tilt.sin(), 0.3 * tilt.sin(), tilt.cos()];
+    m.coat_normal = Vec3::from(m.coat_normal).normalize().into();
+    m
+}
+
+fn sheened(base: Material, color: Vec3, roughness: f32) -> Material {
+    Material { sheen_color: color, sheen_roughness: roughness, ..base }
+}
+
+fn plastic(base: f32, roughness: f32) -> Material {
+    Material { base_color: Vec3::new(base, base * 0.8, base * 0.6), metallic: 0.0, roughness, ..Material::default() }
+}
+
 fn glass(roughness: f32, transmission: f32) -> PackedMaterial {
     pack_material(&Material { base_color: Vec3::ONE, metallic: 0.0, roughness, transmission, ..Material::default() })
 }
@@ -44,6 +62,28 @@ fn cases() -> Vec<(String, PackedMaterial, f32)> {
         v.push((format!("glass leaving r={r}"), glass(r, 1.0), 1.0 / 1.5));
     }
     v.push(("half-transmissive r=0.4".to_string(), glass(0.4, 0.5), 1.5));
+    v.push(("coat r=0.3 over plastic".to_string(), coated(plastic(0.5, 0.6), 0.3, 0.0), 1.5));
+    v.push((
+        "coat r=0.5 tilted over metal".to_string(),
+        coated(Material { metallic: 1.0, ..plastic(0.9, 0.3) }, 0.5, 0.25),
+        1.5,
+    ));
+    v.push((
+        "sheen r=0.5 over lambert".to_string(),
+        pack_material(&sheened(plastic(0.8, 1.0), Vec3::new(1.0, 0.7, 0.5), 0.5)),
+        1.5,
+    ));
+    v.push(("sheen r=0.15 over plastic".to_string(), pack_material(&sheened(plastic(0.5, 0.5), Vec3::ONE, 0.15)), 1.5));
+    v.push((
+        "coat r=0.4 over sheen r=0.8".to_string(),
+        coated(sheened(plastic(0.6, 0.7), Vec3::splat(0.8), 0.8), 0.4, 0.1),
+        1.5,
+    ));
+    v.push((
+        "coat r=0.3 over rough glass".to_string(),
+        coated(Material { transmission: 1.0, ..plastic(1.0, 0.5) }, 0.3, 0.0),
+        1.5,
+    ));
     v
 }
 
@@ -144,5 +184,119 @@ fn near_mirror_ggx_is_finite() {
                 assert!(bsdf_eval(&m, wo, wi, 1.5).is_finite() && bsdf_pdf(&m, wo, wi, 1.5).is_finite());
             }
         }
+    }
+}
+
+/// The sheen's albedo table (src/sheen.rs, built by a quadrature in cos² spacing) against
+/// Monte Carlo with uniform directions, off the table's nodes: bilinear interpolation and
+/// the quadrature stay within 1.5 % + 0.002.
+#[test]
+fn sheen_albedo_table_matches_monte_carlo() {
+    use veach::cpu::sampling::{UNIFORM_HEMISPHERE_PDF, sample_uniform_hemisphere};
+    use veach::sheen::{sheen_albedo, sheen_brdf};
+    let mut rng = Lcg(21);
+    for roughness in [0.1f32, 0.33, 0.52, 0.77, 1.0] {
+        for mu in [0.05f32, 0.23, 0.5, 0.81, 0.97] {
+            let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+            let n = 400_000;
+            let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+            for _ in 0..n {
+                let wi = sample_uniform_hemisphere(glam::Vec2::new(rng.f(), rng.f()));
+                let v = (sheen_brdf(wo, wi, roughness) * wi.z / UNIFORM_HEMISPHERE_PDF) as f64;
+                sum += v;
+                sum2 += v * v;
+            }
+            let mean = sum / n as f64;
+            let se = ((sum2 / n as f64 - mean * mean) / n as f64).sqrt();
+            let table = sheen_albedo(mu, roughness) as f64;
+            assert!(
+                (table - mean).abs() <= 4.0 * se + 0.015 * mean + 0.002,
+                "r={roughness} μ={mu}: table {table} vs Monte Carlo {mean} ± {se}"
+            );
+        }
+    }
+}
+
+/// White furnaces of the layers over a white Lambertian base (no specular), by quadrature:
+/// - a coat keeps 1 − w + w·E_ggx(μ), w = its Fresnel weight: it loses only what its
+///   single-scattering GGX lobe loses (E_ggx from an independent quadrature of D·G2);
+/// - a white sheen never gains, and loses at most E_max − E(μo): the albedo scaling takes
+///   the smaller of the two directions' transmittances.
+#[test]
+fn white_furnaces_of_the_layers_lose_only_what_their_model_explains() {
+    use veach::cpu::microfacet::{ggx_d, ggx_g2};
+    use veach::sheen::sheen_albedo;
+    let lambert = Material { base_color: Vec3::ONE, metallic: 0.0, specular_factor: 0.0, ..Material::default() };
+    let quad = |f: &dyn Fn(Vec3) -> f64| {
+        let (nc, np) = (800usize, 200usize);
+        let mut sum = 0.0;
+        for i in 0..nc {
+            let c = (i as f32 + 0.5) / nc as f32;
+            for j in 0..np {
+                sum += f(direction(c, (j as f32 + 0.5) / np as f32 * 2.0 * PI)) * c as f64;
+            }
+        }
+        sum * 2.0 * std::f64::consts::PI / (nc * np) as f64
+    };
+    for theta_o in [5f32, 30.0, 60.0, 85.0] {
+        let t = theta_o.to_radians();
+        let wo = Vec3::new(t.sin(), 0.0, t.cos());
+        for roughness in [0.3f32, 0.7] {
+            let m = coated(lambert, roughness, 0.0);
+            let energy = quad(&|wi| bsdf_eval(&m, wo, wi, 1.5).y as f64);
+            let a = roughness * roughness;
+            let e_ggx = quad(&|wi| {
+                let h = (wo + wi).normalize();
+                (ggx_d(h, a) * ggx_g2(wo, wi, a) / (4.0 * wo.z * wi.z)) as f64
+            });
+            let w = 0.04 + 0.96 * (1.0 - wo.z as f64).powi(5);
+            let expected = 1.0 - w + w * e_ggx;
+            assert!(
+                (energy - expected).abs() < 2e-3,
+                "coat r={roughness} θo={theta_o}: energy {energy}, model {expected} (E_ggx {e_ggx})"
+            );
+        }
+        for roughness in [0.1f32, 0.4, 1.0] {
+            let m = pack_material(&sheened(lambert, Vec3::ONE, roughness));
+            let energy = quad(&|wi| bsdf_eval(&m, wo, wi, 1.5).y as f64);
+            let e_max = (0..=100).map(|i| sheen_albedo(i as f32 / 100.0, roughness)).fold(0.0f32, f32::max) as f64;
+            let loss_bound = e_max - sheen_albedo(wo.z, roughness) as f64;
+            assert!(energy <= 1.0 + 2e-3, "sheen r={roughness} θo={theta_o}: energy {energy} above 1");
+            assert!(
+                energy >= 1.0 - loss_bound - 2e-3,
+                "sheen r={roughness} θo={theta_o}: energy {energy} loses more than {loss_bound}"
+            );
+        }
+    }
+}
+
+/// A smooth coat (roughness 0, the extension's default) is a Dirac lobe: sampled with the
+/// coat's Fresnel weight as its expected value, found neither by eval nor pdf.
+#[test]
+fn a_smooth_coat_is_a_mirror_of_its_fresnel_weight() {
+    let black = Material { base_color: Vec3::ZERO, metallic: 0.0, specular_factor: 0.0, ..Material::default() };
+    let m = coated(black, 0.0, 0.2);
+    let nc = Vec3::from(m.coat_normal);
+    let mut rng = Lcg(5);
+    for theta_o in [10f32, 50.0, 75.0] {
+        let t = theta_o.to_radians();
+        let wo = Vec3::new(t.sin(), 0.0, t.cos());
+        let expected = 0.04 + 0.96 * (1.0 - nc.dot(wo)).powi(5);
+        let n = 20_000;
+        let mut sum = 0.0f64;
+        for _ in 0..n {
+            let s = bsdf_sample(&m, wo, Vec3::new(rng.f(), rng.f(), rng.f()), 1.5);
+            if s.pdf > 0.0 {
+                assert!(s.delta, "θo={theta_o}: a black base under a smooth coat has only the coat's mirror");
+                let mirror = 2.0 * wo.dot(nc) * nc - wo;
+                assert!((s.wi - mirror).length() < 1e-5, "θo={theta_o}: {} is not the mirror {mirror}", s.wi);
+                sum += s.weight.y as f64;
+            }
+        }
+        let mean = sum / n as f64;
+        assert!((mean - expected as f64).abs() < 1e-4, "θo={theta_o}: mean weight {mean}, coat Fresnel {expected}");
+        let mirror = 2.0 * wo.dot(nc) * nc - wo;
+        assert_eq!(bsdf_eval(&m, wo, mirror, 1.5), Vec3::ZERO);
+        assert_eq!(bsdf_pdf(&m, wo, mirror, 1.5), 0.0);
     }
 }

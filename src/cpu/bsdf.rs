@@ -1,13 +1,17 @@
 //! Twin of `shaders/bsdf.wgsl`: glTF metallic-roughness (GGX specular over Lambert and GGX
-//! transmission).
+//! transmission), under KHR_materials_sheen's sheen and KHR_materials_clearcoat's coat.
 
+use super::clearcoat::{coat_alpha, coat_eval, coat_pdf, coat_sample, coat_weight};
 use super::microfacet::{ggx_d, ggx_g1, ggx_g2, ggx_reflection_pdf, ggx_sample_vndf};
-use super::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use super::sampling::{
+    UNIFORM_HEMISPHERE_PDF, cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere,
+};
 use crate::packed::{Material, luminance};
+use crate::sheen::{sheen_albedo, sheen_albedo_scaling, sheen_brdf};
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::FRAC_1_PI;
 
-pub const DELTA_ALPHA: f32 = 1e-4;
+pub use super::microfacet::DELTA_ALPHA;
 
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample {
@@ -64,12 +68,17 @@ pub fn transmission_albedo(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
 }
 
 #[inline]
-pub fn lobe_probabilities(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
+pub fn lobe_weights(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
     let mut wt = luminance(transmission_albedo(m, cos_o, eta));
     if m.roughness * m.roughness >= DELTA_ALPHA {
         wt = wt.max(0.1 * (1.0 - m.metallic) * m.transmission * luminance(m.base_color.into()));
     }
-    let w = Vec3::new(luminance(bsdf_fresnel(m, cos_o, eta)), luminance(diffuse_albedo(m, cos_o, eta)), wt);
+    Vec3::new(luminance(bsdf_fresnel(m, cos_o, eta)), luminance(diffuse_albedo(m, cos_o, eta)), wt)
+}
+
+#[inline]
+pub fn lobe_probabilities(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
+    let w = lobe_weights(m, cos_o, eta);
     let total = w.x + w.y + w.z;
     if total <= 0.0 {
         return Vec3::ZERO;
@@ -104,7 +113,7 @@ pub fn refract_dir(wo: Vec3, n: Vec3, eta: f32) -> Vec4 {
     (-wo / eta + (cos_i / eta - cos_t) * n).extend(1.0)
 }
 
-pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
+pub fn base_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
     let alpha = m.roughness * m.roughness;
     if wo.z <= 0.0 || wi.z == 0.0 {
         return Vec3::ZERO;
@@ -133,7 +142,7 @@ pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
     f
 }
 
-pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+pub fn base_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
     if wo.z <= 0.0 || wi.z == 0.0 {
         return 0.0;
     }
@@ -158,7 +167,7 @@ pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
     pdf
 }
 
-pub fn bsdf_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
+pub fn base_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
     let none = BsdfSample { wi: Vec3::Z, weight: Vec3::ZERO, pdf: 0.0, delta: false };
     if wo.z <= 0.0 {
         return none;
@@ -196,6 +205,115 @@ pub fn bsdf_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
             return none;
         }
         wi
+    };
+    let pdf = base_pdf(m, wo, wi, eta);
+    if wi.z == 0.0 || pdf <= 0.0 {
+        return none;
+    }
+    BsdfSample { wi, weight: base_eval(m, wo, wi, eta) * (wi.z.abs() / pdf), pdf, delta: false }
+}
+
+/// Has the material a coat or a sheen over its base? Without, the BSDF is the base's alone.
+#[inline]
+pub fn has_layers(m: &Material) -> bool {
+    m.clearcoat > 0.0 || Vec3::from(m.sheen_color).max_element() > 0.0
+}
+
+/// What reaches the base through the layers: 1 − the coat's weight, times the sheen's albedo
+/// scaling (from both directions; a transmitted wi by its |cos|).
+#[inline]
+pub fn base_scaling(m: &Material, wo: Vec3, wi: Vec3, coat: f32) -> f32 {
+    (1.0 - coat) * sheen_albedo_scaling(m.sheen_color.into(), m.sheen_roughness, wo.z, wi.z.abs())
+}
+
+/// Probabilities of sampling the coat, the sheen and the base, from their albedos seen from
+/// wo (the base's from its lobes' weights).
+pub fn layer_probabilities(m: &Material, wo: Vec3, eta: f32) -> Vec3 {
+    let coat = coat_weight(m, wo);
+    let sheen = Vec3::from(m.sheen_color);
+    let e = if sheen.max_element() > 0.0 { sheen_albedo(wo.z, m.sheen_roughness) } else { 0.0 };
+    let b = lobe_weights(m, wo.z, eta);
+    let w = Vec3::new(
+        coat,
+        (1.0 - coat) * luminance(sheen) * e,
+        (1.0 - coat) * (1.0 - sheen.max_element() * e) * (b.x + b.y + b.z),
+    );
+    let total = w.x + w.y + w.z;
+    if total <= 0.0 {
+        return Vec3::ZERO;
+    }
+    w / total
+}
+
+/// f(wo, wi) without the cosine: coat + (1 − coat weight) · (sheen + base · sheen scaling).
+/// Dirac lobes are not included.
+pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
+    let base = base_eval(m, wo, wi, eta);
+    if !has_layers(m) {
+        return base;
+    }
+    if wo.z <= 0.0 || wi.z == 0.0 {
+        return Vec3::ZERO;
+    }
+    let coat = coat_weight(m, wo);
+    let mut f = base * base_scaling(m, wo, wi, coat);
+    if wi.z > 0.0 {
+        f += (1.0 - coat) * Vec3::from(m.sheen_color) * sheen_brdf(wo, wi, m.sheen_roughness);
+        f += Vec3::splat(coat * coat_eval(m, wo, wi));
+    }
+    f
+}
+
+pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+    if !has_layers(m) {
+        return base_pdf(m, wo, wi, eta);
+    }
+    if wo.z <= 0.0 || wi.z == 0.0 {
+        return 0.0;
+    }
+    let p = layer_probabilities(m, wo, eta);
+    let mut pdf = p.z * base_pdf(m, wo, wi, eta);
+    if wi.z > 0.0 {
+        pdf += p.x * coat_pdf(m, wo, wi) + p.y * UNIFORM_HEMISPHERE_PDF;
+    }
+    pdf
+}
+
+/// Picks the base, the coat or the sheen with u.x, then a direction from it (the base with
+/// u.x rescaled to its share). Dirac lobes of the base keep its layers' scaling.
+pub fn bsdf_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
+    if !has_layers(m) {
+        return base_sample(m, wo, u, eta);
+    }
+    let none = BsdfSample { wi: Vec3::Z, weight: Vec3::ZERO, pdf: 0.0, delta: false };
+    if wo.z <= 0.0 {
+        return none;
+    }
+    let p = layer_probabilities(m, wo, eta);
+    let wi = if u.x < p.z {
+        let s = base_sample(m, wo, Vec3::new(u.x / p.z, u.y, u.z), eta);
+        if s.pdf <= 0.0 {
+            return none;
+        }
+        if s.delta {
+            let scale = base_scaling(m, wo, s.wi, coat_weight(m, wo));
+            return BsdfSample { wi: s.wi, weight: s.weight * (scale / p.z), pdf: s.pdf * p.z, delta: true };
+        }
+        s.wi
+    } else if u.x < p.z + p.x {
+        let wi = coat_sample(m, wo, Vec2::new(u.y, u.z));
+        if wi.z <= 0.0 {
+            return none;
+        }
+        if coat_alpha(m) < DELTA_ALPHA {
+            return BsdfSample { wi, weight: Vec3::splat(coat_weight(m, wo) / p.x), pdf: p.x, delta: true };
+        }
+        wi
+    } else {
+        if p.y <= 0.0 {
+            return none;
+        }
+        sample_uniform_hemisphere(Vec2::new(u.y, u.z))
     };
     let pdf = bsdf_pdf(m, wo, wi, eta);
     if wi.z == 0.0 || pdf <= 0.0 {

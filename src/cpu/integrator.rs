@@ -8,11 +8,11 @@ use super::frame::{Frame, frame_from_normal, from_local, to_local};
 use super::instance::world_triangle;
 use super::light_tree::LightContext;
 use super::lights::{LightSample, light_pdf, sample_light, sample_punctual};
-use super::material::{material_at, shading_normal, triangle_uv};
+use super::material::{coat_normal, material_at, shading_normal, triangle_uv};
 use super::mis::mis_weight;
 use super::sampler::{Sampler, sample_1d, sample_2d};
 use crate::Strategy;
-use crate::packed::{Material, PackedScene, TRI_MIRRORED};
+use crate::packed::{Material, NO_TEXTURE, PackedScene, TRI_MIRRORED};
 use crate::params::{LIGHT_SAMPLER_TREE, Params};
 use glam::{UVec2, Vec3};
 
@@ -95,7 +95,8 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
         }
         let tri = &world_triangle(scene, hit.tri, hit.instance);
         let uv = triangle_uv(scene, hit.tri, hit.u, hit.v);
-        let m = &material_at(scene, &scene.materials[tri.material as usize], uv);
+        let mut mat = material_at(scene, &scene.materials[tri.material as usize], uv);
+        let m = &mat;
         let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
         let point = Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2;
         let ng_cross = e1.cross(e2).normalize();
@@ -136,6 +137,17 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
         }
         let frame = frame_from_normal(ns);
         let wo = to_local(&frame, -ray.dir);
+        // A coat follows its own normal map, or the interpolated normal when the base's is mapped.
+        if mat.clearcoat > 0.0
+            && (mat.normal_texture.layer != NO_TEXTURE || mat.clearcoat_normal_texture.layer != NO_TEXTURE)
+        {
+            let mut nc = coat_normal(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, &mat, uv);
+            if nc.dot(ray.dir) > 0.0 {
+                nc = -nc;
+            }
+            mat.coat_normal = to_local(&frame, nc).into();
+        }
+        let m = &mat;
 
         let ctx = LightContext { point, normal: ns, reflect_only: m.transmission <= 0.0 };
         // Next-event estimation: one light sample. With the BSDF strategy alone it still

@@ -6,7 +6,7 @@ use super::rng::pcg_hash;
 use super::texture::sample_texture;
 use crate::packed::{
     MAT_ALPHA_MASK, Material, NO_TEXTURE, PackedScene, TRI_HAS_NORMALS, TRI_HAS_TANGENTS, TRI_MIRRORED,
-    TRI_TANGENT_SIGN_SHIFT, Triangle, oct_decode,
+    TRI_TANGENT_SIGN_SHIFT, TextureRef, Triangle, oct_decode,
 };
 use glam::{Vec2, Vec3};
 
@@ -29,6 +29,34 @@ pub fn material_at(scene: &PackedScene, m: &Material, uv: Vec2) -> Material {
     }
     if m.emissive_texture.layer != NO_TEXTURE {
         r.emission = (Vec3::from(m.emission) * sample_texture(scene, &m.emissive_texture, uv).truncate()).into();
+    }
+    if m.transmission_texture.layer != NO_TEXTURE {
+        r.transmission = m.transmission * sample_texture(scene, &m.transmission_texture, uv).x;
+    }
+    if m.specular_texture.layer != NO_TEXTURE || m.specular_color_texture.layer != NO_TEXTURE {
+        let mut factor = m.dielectric_f90;
+        let mut f0 = Vec3::from(m.specular_f0);
+        if m.specular_texture.layer != NO_TEXTURE {
+            factor *= sample_texture(scene, &m.specular_texture, uv).w;
+        }
+        if m.specular_color_texture.layer != NO_TEXTURE {
+            f0 *= sample_texture(scene, &m.specular_color_texture, uv).truncate();
+        }
+        r.dielectric_f0 = (f0.min(Vec3::ONE) * factor).into();
+        r.dielectric_f90 = factor;
+    }
+    if m.clearcoat_texture.layer != NO_TEXTURE {
+        r.clearcoat = m.clearcoat * sample_texture(scene, &m.clearcoat_texture, uv).x;
+    }
+    if m.clearcoat_roughness_texture.layer != NO_TEXTURE {
+        r.clearcoat_roughness = m.clearcoat_roughness * sample_texture(scene, &m.clearcoat_roughness_texture, uv).y;
+    }
+    if m.sheen_color_texture.layer != NO_TEXTURE {
+        r.sheen_color =
+            (Vec3::from(m.sheen_color) * sample_texture(scene, &m.sheen_color_texture, uv).truncate()).into();
+    }
+    if m.sheen_roughness_texture.layer != NO_TEXTURE {
+        r.sheen_roughness = m.sheen_roughness * sample_texture(scene, &m.sheen_roughness_texture, uv).w;
     }
     r
 }
@@ -68,6 +96,38 @@ pub fn shading_normal(
     m: &Material,
     uv: Vec2,
 ) -> Vec3 {
+    mapped_normal(scene, tri, index, instance, u, v, ng, &m.normal_texture, m.normal_scale, uv)
+}
+
+/// The clearcoat's normal: its own normal map, else the interpolated normal.
+#[allow(clippy::too_many_arguments)]
+pub fn coat_normal(
+    scene: &PackedScene,
+    tri: &Triangle,
+    index: u32,
+    instance: u32,
+    u: f32,
+    v: f32,
+    ng: Vec3,
+    m: &Material,
+    uv: Vec2,
+) -> Vec3 {
+    mapped_normal(scene, tri, index, instance, u, v, ng, &m.clearcoat_normal_texture, m.clearcoat_normal_scale, uv)
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn mapped_normal(
+    scene: &PackedScene,
+    tri: &Triangle,
+    index: u32,
+    instance: u32,
+    u: f32,
+    v: f32,
+    ng: Vec3,
+    map: &TextureRef,
+    scale: f32,
+    uv: Vec2,
+) -> Vec3 {
     let mut n = ng;
     let a = &scene.attributes[index as usize];
     let inst = (scene.instance_count > 0).then(|| load_instance(scene, instance));
@@ -79,7 +139,7 @@ pub fn shading_normal(
         let len2 = s.dot(s);
         n = if len2 > 0.0 { s / len2.sqrt() } else { ng };
     }
-    if tri.flags & TRI_HAS_TANGENTS == 0 || m.normal_texture.layer == NO_TEXTURE {
+    if tri.flags & TRI_HAS_TANGENTS == 0 || map.layer == NO_TEXTURE {
         return n;
     }
     let mut t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12[0]) + v * oct_decode(a.t12[1]);
@@ -97,8 +157,8 @@ pub fn shading_normal(
         w = -w;
     }
     let b = n.cross(t) * w;
-    let c = sample_texture(scene, &m.normal_texture, uv).truncate() * 2.0 - Vec3::ONE;
-    let mapped = t * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + n * c.z;
+    let c = sample_texture(scene, map, uv).truncate() * 2.0 - Vec3::ONE;
+    let mapped = t * (c.x * scale) + b * (c.y * scale) + n * c.z;
     let mlen2 = mapped.dot(mapped);
     if mlen2 > 1e-12 { mapped / mlen2.sqrt() } else { n }
 }

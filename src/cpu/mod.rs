@@ -6,6 +6,7 @@
 pub mod bsdf;
 pub mod bvh;
 pub mod camera;
+pub mod clearcoat;
 pub mod environment;
 pub mod frame;
 pub mod instance;

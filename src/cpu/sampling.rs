@@ -23,6 +23,16 @@ pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
 
 pub const UNIFORM_SPHERE_PDF: f32 = 0.079_577_47;
 
+pub fn sample_uniform_hemisphere(u: Vec2) -> Vec3 {
+    let z = u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// 1 / 2π.
+pub const UNIFORM_HEMISPHERE_PDF: f32 = 0.159_154_94;
+
 pub fn sample_uniform_disk(u: Vec2) -> Vec2 {
     let r = u.x.sqrt();
     let phi = 2.0 * PI * u.y;

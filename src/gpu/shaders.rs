@@ -18,6 +18,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
     ("camera.wgsl", include_str!("../../shaders/camera.wgsl")),
     ("microfacet.wgsl", include_str!("../../shaders/microfacet.wgsl")),
+    ("clearcoat.wgsl", include_str!("../../shaders/clearcoat.wgsl")),
+    ("sheen.wgsl", include_str!("../../shaders/sheen.wgsl")),
     ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
     ("environment.wgsl", include_str!("../../shaders/environment.wgsl")),
     ("spherical_triangle.wgsl", include_str!("../../shaders/spherical_triangle.wgsl")),

@@ -12,11 +12,13 @@ pub struct Features {
     pub punctual_lights: bool,
     pub transmission: bool,
     pub instancing: bool,
+    pub clearcoat: bool,
+    pub sheen: bool,
 }
 
 impl Features {
     /// The pipeline constants of `shaders/common.wgsl`.
-    pub fn constants(&self) -> [(&'static str, f64); 5] {
+    pub fn constants(&self) -> [(&'static str, f64); 7] {
         let f = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("ALPHA_TEST", f(self.alpha_test)),
@@ -24,6 +26,8 @@ impl Features {
             ("PUNCTUAL_LIGHTS", f(self.punctual_lights)),
             ("TRANSMISSION", f(self.transmission)),
             ("INSTANCING", f(self.instancing)),
+            ("CLEARCOAT", f(self.clearcoat)),
+            ("SHEEN", f(self.sheen)),
         ]
     }
 }
@@ -31,9 +35,22 @@ impl Features {
 impl PackedScene {
     pub fn features(&self) -> Features {
         let textured = |m: &Material| {
-            [m.base_color_texture, m.metallic_roughness_texture, m.emissive_texture, m.normal_texture]
-                .iter()
-                .any(|t| t.layer != NO_TEXTURE)
+            [
+                m.base_color_texture,
+                m.metallic_roughness_texture,
+                m.emissive_texture,
+                m.normal_texture,
+                m.transmission_texture,
+                m.specular_texture,
+                m.specular_color_texture,
+                m.clearcoat_texture,
+                m.clearcoat_roughness_texture,
+                m.clearcoat_normal_texture,
+                m.sheen_color_texture,
+                m.sheen_roughness_texture,
+            ]
+            .iter()
+            .any(|t| t.layer != NO_TEXTURE)
         };
         Features {
             alpha_test: self.triangles.iter().any(|t| t.flags & TRI_ALPHA != 0),
@@ -41,6 +58,8 @@ impl PackedScene {
             punctual_lights: self.punctual_count > 0,
             transmission: self.materials.iter().any(|m| m.transmission > 0.0 || m.attenuation != [0.0; 3]),
             instancing: self.instance_count > 0,
+            clearcoat: self.materials.iter().any(|m| m.clearcoat > 0.0),
+            sheen: self.materials.iter().any(|m| m.sheen_color.iter().any(|&c| c > 0.0)),
         }
     }
 }

@@ -94,11 +94,32 @@ pub struct Material {
     /// MAT_* bits.
     pub flags: u32,
     pub normal_scale: f32,
-    pub pad: [f32; 3],
+    /// KHR_materials_clearcoat: strength (0: no coat), roughness, normal-map scale.
+    pub clearcoat: f32,
+    pub clearcoat_roughness: f32,
+    pub clearcoat_normal_scale: f32,
+    /// KHR_materials_sheen (black: no sheen).
+    pub sheen_color: [f32; 3],
+    pub sheen_roughness: f32,
+    /// The coat's normal in the local shading frame. Not scene data: (0, 0, 1) in the buffer,
+    /// set per hit by the integrator when the coat's normal differs from the shading normal.
+    pub coat_normal: [f32; 3],
+    pub pad0: f32,
+    /// ((ior − 1)/(ior + 1))² × specularColor before clamping, for specular textures.
+    pub specular_f0: [f32; 3],
+    pub pad1: f32,
     pub base_color_texture: TextureRef,
     pub metallic_roughness_texture: TextureRef,
     pub emissive_texture: TextureRef,
     pub normal_texture: TextureRef,
+    pub transmission_texture: TextureRef,
+    pub specular_texture: TextureRef,
+    pub specular_color_texture: TextureRef,
+    pub clearcoat_texture: TextureRef,
+    pub clearcoat_roughness_texture: TextureRef,
+    pub clearcoat_normal_texture: TextureRef,
+    pub sheen_color_texture: TextureRef,
+    pub sheen_roughness_texture: TextureRef,
 }
 
 /// A KHR_lights_punctual light as four rows of the light-data buffer.

@@ -40,11 +40,27 @@ pub fn pack_material(m: &Material) -> PackedMaterial {
         attenuation: attenuation.into(),
         flags,
         normal_scale: m.normal_scale,
-        pad: [0.0; 3],
+        clearcoat: m.clearcoat,
+        clearcoat_roughness: m.clearcoat_roughness,
+        clearcoat_normal_scale: m.clearcoat_normal_scale,
+        sheen_color: m.sheen_color.into(),
+        sheen_roughness: m.sheen_roughness,
+        coat_normal: [0.0, 0.0, 1.0],
+        pad0: 0.0,
+        specular_f0: specular_f0(m).into(),
+        pad1: 0.0,
         base_color_texture: pack_texture_ref(m.base_color_texture, true),
         metallic_roughness_texture: pack_texture_ref(m.metallic_roughness_texture, false),
         emissive_texture: pack_texture_ref(m.emissive_texture, true),
         normal_texture: pack_texture_ref(m.normal_texture, false),
+        transmission_texture: pack_texture_ref(m.transmission_texture, false),
+        specular_texture: pack_texture_ref(m.specular_texture, false),
+        specular_color_texture: pack_texture_ref(m.specular_color_texture, true),
+        clearcoat_texture: pack_texture_ref(m.clearcoat_texture, false),
+        clearcoat_roughness_texture: pack_texture_ref(m.clearcoat_roughness_texture, false),
+        clearcoat_normal_texture: pack_texture_ref(m.clearcoat_normal_texture, false),
+        sheen_color_texture: pack_texture_ref(m.sheen_color_texture, true),
+        sheen_roughness_texture: pack_texture_ref(m.sheen_roughness_texture, false),
     }
 }
 
@@ -62,6 +78,11 @@ fn pack_texture_ref(t: Option<TextureRef>, srgb: bool) -> PackedTextureRef {
 
 /// The dielectric F0 of glTF's metallic-roughness model with KHR_materials_specular/_ior.
 pub fn dielectric_f0(m: &Material) -> Vec3 {
+    specular_f0(m).min(Vec3::ONE) * m.specular_factor
+}
+
+/// ((ior − 1)/(ior + 1))² × specularColor, before the clamp to 1 and the specular factor.
+pub fn specular_f0(m: &Material) -> Vec3 {
     let r = (m.ior - 1.0) / (m.ior + 1.0);
-    (r * r * m.specular_color).min(Vec3::ONE) * m.specular_factor
+    r * r * m.specular_color
 }

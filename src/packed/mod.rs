@@ -89,6 +89,8 @@ pub struct PackedScene {
     /// The punctual lights (also in `light_data`), kept to rebuild it for a new environment.
     pub punctuals: Vec<Punctual>,
     pub punctual_base: u32,
+    /// First row of the sheen albedo table (after the punctual lights) in `light_data`.
+    pub sheen_base: u32,
     pub punctual_count: u32,
     /// Texture array: `texture_layers` square layers of `texture_size`² RGBA8 texels (one
     /// u32 each, R in the low byte), row-major, layer after layer. At least one layer.
@@ -225,6 +227,7 @@ impl PackedScene {
             light_data: Vec::new(),
             punctuals,
             punctual_base: 0,
+            sheen_base: 0,
             punctual_count: scene.punctual_lights.len() as u32,
             texels,
             texture_size,
@@ -252,6 +255,11 @@ impl PackedScene {
         };
         self.punctual_base = rows.len() as u32;
         rows.extend_from_slice(bytemuck::cast_slice::<Punctual, [f32; 4]>(&self.punctuals));
+        // The table only when a material has sheen: it costs the quadrature once per process.
+        self.sheen_base = rows.len() as u32;
+        if self.materials.iter().any(|m| m.sheen_color.iter().any(|&c| c > 0.0)) {
+            rows.extend(crate::sheen::sheen_albedo_rows());
+        }
         self.light_data = rows;
         (self.env_width, self.env_height, self.env_total) = (w, h, total);
         self.environment = environment.radiance;

@@ -131,6 +131,29 @@ pub struct Material {
     pub emissive_texture: Option<TextureRef>,
     pub normal_texture: Option<TextureRef>,
     pub normal_scale: f32,
+    /// KHR_materials_transmission.transmissionTexture (red multiplies `transmission`).
+    pub transmission_texture: Option<TextureRef>,
+    /// KHR_materials_specular's textures: alpha multiplies `specular_factor`, RGB (sRGB)
+    /// multiplies `specular_color`.
+    pub specular_texture: Option<TextureRef>,
+    pub specular_color_texture: Option<TextureRef>,
+    /// KHR_materials_clearcoat: a GGX dielectric coat (ior 1.5) of this strength and roughness
+    /// over the rest (0: no coat). Red of `clearcoat_texture` multiplies the strength, green of
+    /// `clearcoat_roughness_texture` the roughness; the coat has its own normal map (without
+    /// one it follows the interpolated normal, not the base's normal map).
+    pub clearcoat: f32,
+    pub clearcoat_roughness: f32,
+    pub clearcoat_texture: Option<TextureRef>,
+    pub clearcoat_roughness_texture: Option<TextureRef>,
+    pub clearcoat_normal_texture: Option<TextureRef>,
+    pub clearcoat_normal_scale: f32,
+    /// KHR_materials_sheen: the Charlie sheen of this color and roughness over the base (black:
+    /// no sheen). RGB (sRGB) of `sheen_color_texture` multiplies the color, alpha of
+    /// `sheen_roughness_texture` the roughness.
+    pub sheen_color: Vec3,
+    pub sheen_roughness: f32,
+    pub sheen_color_texture: Option<TextureRef>,
+    pub sheen_roughness_texture: Option<TextureRef>,
 }
 
 impl Default for Material {
@@ -155,6 +178,19 @@ impl Default for Material {
             emissive_texture: None,
             normal_texture: None,
             normal_scale: 1.0,
+            transmission_texture: None,
+            specular_texture: None,
+            specular_color_texture: None,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+            clearcoat_texture: None,
+            clearcoat_roughness_texture: None,
+            clearcoat_normal_texture: None,
+            clearcoat_normal_scale: 1.0,
+            sheen_color: Vec3::ZERO,
+            sheen_roughness: 0.0,
+            sheen_color_texture: None,
+            sheen_roughness_texture: None,
         }
     }
 }

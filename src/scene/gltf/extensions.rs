@@ -10,13 +10,14 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_volume",
     "KHR_lights_punctual",
     "KHR_materials_unlit",
+    "KHR_materials_clearcoat",
+    "KHR_materials_sheen",
+    "KHR_materials_pbrSpecularGlossiness",
 ];
 
 /// Extensions veach knows and ignores for now; files that merely use them render, with one
 /// warning each.
 const KNOWN_UNIMPLEMENTED: &[&str] = &[
-    "KHR_materials_clearcoat",
-    "KHR_materials_sheen",
     "KHR_materials_iridescence",
     "KHR_materials_anisotropy",
     "KHR_materials_dispersion",

@@ -1,13 +1,20 @@
 //! glTF materials (metallic-roughness and the KHR extensions veach reads) as `Material`.
 
-use crate::scene::{AlphaMode, Material, TextureRef, Wrap};
+use crate::scene::{AlphaMode, Material, Texture, TextureRef, Wrap};
 use glam::Vec3;
+use serde_json::Value;
 
 /// Largest emitted radiance kept: far above any physical source in scene units, yet far from
 /// f32's overflow when divided by a small light pdf.
 pub const MAX_RADIANCE: f32 = 1e15;
 
-pub fn convert_material(m: &gltf::Material, image_slot: &[Option<u32>], warnings: &mut Vec<String>) -> Material {
+pub fn convert_material(
+    m: &gltf::Material,
+    doc: &gltf::Document,
+    image_slot: &[Option<u32>],
+    textures: &mut Vec<Texture>,
+    warnings: &mut Vec<String>,
+) -> Material {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, a] = pbr.base_color_factor();
     let strength = m.emissive_strength().unwrap_or(1.0);
@@ -37,6 +44,25 @@ pub fn convert_material(m: &gltf::Material, image_slot: &[Option<u32>], warnings
             wrap: [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
         })
     };
+    // A textureInfo of an extension the gltf crate does not model, from its JSON (its scale
+    // too, for normal textures).
+    let json_info = |v: Option<&Value>| -> Option<(gltf::texture::Texture, u32, Option<Transform>, f32)> {
+        let v = v?;
+        let tex = doc.textures().nth(v.get("index")?.as_u64()? as usize)?;
+        let tt = v
+            .get("extensions")
+            .and_then(|e| e.get("KHR_texture_transform"))
+            .and_then(|t| serde_json::from_value::<gltf::json::extensions::texture::TextureTransform>(t.clone()).ok());
+        let coord = v.get("texCoord").and_then(Value::as_u64).unwrap_or(0) as u32;
+        let coord = tt.as_ref().and_then(|t| t.tex_coord).unwrap_or(coord);
+        let scale = v.get("scale").and_then(Value::as_f64).unwrap_or(1.0) as f32;
+        Some((tex, coord, tt.map(|t| (t.offset.0, t.rotation.0, t.scale.0)), scale))
+    };
+    fn without_scale<'a>(
+        i: Option<(gltf::texture::Texture<'a>, u32, Option<Transform>, f32)>,
+    ) -> Option<(gltf::texture::Texture<'a>, u32, Option<Transform>)> {
+        i.map(|(t, c, x, _)| (t, c, x))
+    }
     fn info<'a>(i: Option<gltf::texture::Info<'a>>) -> Option<(gltf::texture::Texture<'a>, u32, Option<Transform>)> {
         i.map(|i| {
             let tt = i.texture_transform();
@@ -66,9 +92,26 @@ pub fn convert_material(m: &gltf::Material, image_slot: &[Option<u32>], warnings
         Some(v) => (sane3(Vec3::from(v.attenuation_color())).min(Vec3::ONE), v.attenuation_distance()),
         None => (Vec3::ONE, f32::INFINITY),
     };
-    if m.transmission().and_then(|t| t.transmission_texture()).is_some() {
-        warnings.push(format!("{name}: transmissionTexture is not supported; using transmissionFactor"));
-    }
+    let transmission_texture = texture(info(m.transmission().and_then(|t| t.transmission_texture())));
+    let specular_texture = texture(info(m.specular().and_then(|s| s.specular_texture())));
+    let specular_color_texture = texture(info(m.specular().and_then(|s| s.specular_color_texture())));
+    let coat = m.extension_value("KHR_materials_clearcoat");
+    let number = |v: Option<&Value>, key: &str, default: f32| {
+        v.and_then(|v| v.get(key)).and_then(Value::as_f64).map_or(default, |x| x as f32)
+    };
+    let clearcoat_texture = texture(without_scale(json_info(coat.and_then(|c| c.get("clearcoatTexture")))));
+    let clearcoat_roughness_texture =
+        texture(without_scale(json_info(coat.and_then(|c| c.get("clearcoatRoughnessTexture")))));
+    let coat_normal = json_info(coat.and_then(|c| c.get("clearcoatNormalTexture")));
+    let clearcoat_normal_scale = coat_normal.as_ref().map_or(1.0, |n| n.3);
+    let clearcoat_normal_texture = texture(without_scale(coat_normal));
+    let sheen = m.extension_value("KHR_materials_sheen");
+    let sheen_color_texture = texture(without_scale(json_info(sheen.and_then(|c| c.get("sheenColorTexture")))));
+    let sheen_roughness_texture = texture(without_scale(json_info(sheen.and_then(|c| c.get("sheenRoughnessTexture")))));
+    let sheen_color = sheen
+        .and_then(|v| v.get("sheenColorFactor"))
+        .and_then(|v| serde_json::from_value::<[f32; 3]>(v.clone()).ok())
+        .map_or(Vec3::ZERO, Vec3::from);
     let material = Material {
         // glTF's factors are in [0, 1]; a hostile 1e20 would overflow a path's throughput.
         base_color: sane3(Vec3::new(r, g, b)).min(Vec3::ONE),
@@ -93,8 +136,93 @@ pub fn convert_material(m: &gltf::Material, image_slot: &[Option<u32>], warnings
         emissive_texture,
         normal_texture,
         normal_scale: sane(normal_scale, -100.0, 100.0, 1.0),
+        transmission_texture,
+        specular_texture,
+        specular_color_texture,
+        clearcoat: sane(number(coat, "clearcoatFactor", 0.0), 0.0, 1.0, 0.0),
+        clearcoat_roughness: sane(number(coat, "clearcoatRoughnessFactor", 0.0), 0.0, 1.0, 0.0),
+        clearcoat_texture,
+        clearcoat_roughness_texture,
+        clearcoat_normal_texture,
+        clearcoat_normal_scale: sane(clearcoat_normal_scale, -100.0, 100.0, 1.0),
+        sheen_color: sane3(sheen_color).min(Vec3::ONE),
+        sheen_roughness: sane(number(sheen, "sheenRoughnessFactor", 0.0), 0.0, 1.0, 0.0),
+        sheen_color_texture,
+        sheen_roughness_texture,
+    };
+    let material = match m.pbr_specular_glossiness() {
+        Some(sg) => {
+            let (material, missing) = specular_glossiness(material, &sg, &mut texture, textures);
+            if missing {
+                warnings.push(format!("{name}: its specular-glossiness texture is missing"));
+            }
+            material
+        }
+        None => material,
     };
     if m.extension_value("KHR_materials_unlit").is_some() { unlit(material) } else { material }
+}
+
+/// KHR_materials_pbrSpecularGlossiness as metallic-roughness, as Blender's importer does: the
+/// diffuse color becomes the base color of a non-metal, roughness = 1 − glossiness, and the
+/// specular color becomes the dielectric's F0 (specularColor = specular / 0.04 at ior 1.5,
+/// with the RGB of the specular-glossiness texture as the specular color texture). A
+/// glossiness texture (its alpha) becomes a new roughness texture, 1 − glossiness × alpha in
+/// green.
+fn specular_glossiness<'a>(
+    m: Material,
+    sg: &gltf::material::PbrSpecularGlossiness<'a>,
+    texture: &mut impl FnMut(
+        Option<(gltf::texture::Texture<'a>, u32, Option<([f32; 2], f32, [f32; 2])>)>,
+    ) -> Option<TextureRef>,
+    textures: &mut Vec<Texture>,
+) -> (Material, bool) {
+    let finite = |v: f32, default: f32| if v.is_finite() { v.clamp(0.0, 1.0) } else { default };
+    let [r, g, b, a] = sg.diffuse_factor().map(|v| finite(v, 1.0));
+    let glossiness = finite(sg.glossiness_factor(), 1.0);
+    let specular = Vec3::from(sg.specular_factor().map(|v| finite(v, 1.0)));
+    let info = |i: Option<gltf::texture::Info<'a>>| {
+        i.map(|i| {
+            let tt = i.texture_transform();
+            let coord = tt.as_ref().and_then(|t| t.tex_coord()).unwrap_or(i.tex_coord());
+            (i.texture(), coord, tt.map(|t| (t.offset(), t.rotation(), t.scale())))
+        })
+    };
+    let sg_texture = texture(info(sg.specular_glossiness_texture()));
+    let mut roughness = 1.0 - glossiness;
+    let mut roughness_texture = None;
+    let mut missing = false;
+    if let Some(t) = sg_texture {
+        match textures.get(t.texture as usize) {
+            Some(source) => {
+                let mut rgba = source.rgba.clone();
+                for px in rgba.chunks_exact_mut(4) {
+                    let gloss = glossiness * px[3] as f32 / 255.0;
+                    px.copy_from_slice(&[0, ((1.0 - gloss) * 255.0).round() as u8, 0, 255]);
+                }
+                let derived = Texture { name: format!("{} (roughness)", source.name), rgba, ..*source };
+                roughness = 1.0;
+                roughness_texture = Some(TextureRef { texture: textures.len() as u32, ..t });
+                textures.push(derived);
+            }
+            None => missing = true,
+        }
+    }
+    let material = Material {
+        base_color: Vec3::new(r, g, b),
+        alpha: a,
+        base_color_texture: texture(info(sg.diffuse_texture())),
+        metallic: 0.0,
+        roughness,
+        metallic_roughness_texture: roughness_texture,
+        ior: 1.5,
+        specular_factor: 1.0,
+        specular_color: specular / 0.04,
+        specular_color_texture: sg_texture,
+        specular_texture: None,
+        ..m
+    };
+    (material, missing)
 }
 
 /// KHR_materials_unlit: the surface shows its base color (factor × texture) whatever the

@@ -135,7 +135,7 @@ fn from_document(
         }
     }
     for m in doc.materials() {
-        scene.materials.push(convert_material(&m, &image_slot, warnings));
+        scene.materials.push(convert_material(&m, doc, &image_slot, &mut scene.textures, warnings));
     }
     // Primitives without a material use glTF's default one, appended last.
     let default_material = scene.materials.len() as u32;
