@@ -161,3 +161,31 @@ fn vr_gallery_shows_its_baked_lighting_unlit() {
     eprintln!("VR Gallery: mean luminance {mean}, range {lo}..{hi}");
     assert!(mean > 0.1 && hi > 2.0 * lo, "mean {mean}, range {lo}..{hi}");
 }
+
+/// SpecGlossEmissive (glTF-Blender-IO): its SOURCE.txt says each spec-gloss sphere should match
+/// its metal-rough twin's emission, and a spec-gloss sphere of default factors (specular 1,
+/// glossiness 0) is a rough white mirror. The file requires KHR_materials_pbrSpecularGlossiness
+/// and loads; converted to metallic-roughness, the default sphere is a fully rough non-metal
+/// whose Fresnel is 1 at every angle (F0 = specular = 1), so no diffuse is left.
+#[test]
+fn specular_glossiness_spheres_match_their_metal_rough_twins() {
+    let Some(dir) = models_dir() else { return };
+    let path = dir.join("SpecGlossEmissive-blenderio/14_emission_strength.gltf");
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let (scene, _) = common::load_pair(&path, None).unwrap();
+    let names: Vec<&str> = doc["materials"].as_array().unwrap().iter().map(|m| m["name"].as_str().unwrap()).collect();
+    let by_name = |n: &str| &scene.materials[names.iter().position(|x| *x == n).unwrap()];
+    for (sg, mr) in [
+        ("SpecGlossEmissiveStrength", "pbrEmissiveStrength"),
+        ("SpecGlossEmissiveGrayStrength", "pbrEmissiveGrayStrength"),
+        ("SpecGlossEmissiveStrengthTexture", "pbrEmissiveStrengthTexture"),
+        ("SpecGlossEmissiveGrayTexture", "pbrEmissiveGrayTexture"),
+    ] {
+        assert_eq!(by_name(sg).emission, by_name(mr).emission, "{sg} vs {mr}");
+        assert_eq!(by_name(sg).emissive_texture.is_some(), by_name(mr).emissive_texture.is_some(), "{sg} vs {mr}");
+    }
+    let plain = veach::packed::pack_material(by_name("SpecGloss"));
+    assert_eq!((plain.metallic, plain.roughness), (0.0, 1.0));
+    assert_eq!(plain.dielectric_f0, [1.0; 3], "F0 is the specular factor");
+    assert_eq!(plain.base_color, [1.0; 3]);
+}
