@@ -107,6 +107,12 @@ fn refraction_half_vector(wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec4<f32> {
     return vec4<f32>(h, d * d);
 }
 
+// Thin-walled transmission continues a microfacet reflection through the sheet: the reflected
+// direction mirrored in the tangent plane (and back).
+fn thin_reflection(w: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(w.x, w.y, -w.z);
+}
+
 // Refraction of wo through a surface with normal n (same side as wo); w = 0 under total
 // internal reflection.
 fn refract_dir(wo: vec3<f32>, n: vec3<f32>, eta: f32) -> vec4<f32> {
@@ -128,6 +134,13 @@ fn base_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec3<f32> {
     if (wi.z < 0.0) {
         if (!TRANSMISSION || alpha < DELTA_ALPHA || m.transmission <= 0.0) {
             return vec3<f32>(0.0);
+        }
+        if ((m.flags & MAT_THIN_WALLED) != 0u) {
+            let r = thin_reflection(wi);
+            let h = normalize(wo + r);
+            let f = fresnel_dielectric(dot(wo, h), eta);
+            let ft = ggx_d(h, alpha) * ggx_g2(wo, r, alpha) * (1.0 - f) / (4.0 * wo.z * r.z);
+            return (1.0 - m.metallic) * m.transmission * m.base_color * ft;
         }
         let hd = refraction_half_vector(wo, wi, eta);
         if (hd.w <= 0.0) {
@@ -157,6 +170,10 @@ fn base_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> f32 {
     if (wi.z < 0.0) {
         if (!TRANSMISSION || alpha < DELTA_ALPHA || p.z <= 0.0) {
             return 0.0;
+        }
+        if ((m.flags & MAT_THIN_WALLED) != 0u) {
+            let r = thin_reflection(wi);
+            return p.z * ggx_reflection_pdf(wo, normalize(wo + r), alpha);
         }
         let hd = refraction_half_vector(wo, wi, eta);
         if (hd.w <= 0.0) {
@@ -198,6 +215,17 @@ fn base_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample
         if (!TRANSMISSION || p.z <= 0.0) {
             return none;
         }
+        if ((m.flags & MAT_THIN_WALLED) != 0u) {
+            if (alpha < DELTA_ALPHA) {
+                return BsdfSample(-wo, transmission_albedo(m, wo.z, eta) / p.z, p.z, true);
+            }
+            let hm = ggx_sample_vndf(wo, alpha, u.yz);
+            let r = 2.0 * dot(wo, hm) * hm - wo;
+            if (r.z <= 0.0) {
+                return none;
+            }
+            wi = thin_reflection(r);
+        } else {
         var h = vec3<f32>(0.0, 0.0, 1.0);
         if (alpha >= DELTA_ALPHA) {
             h = ggx_sample_vndf(wo, alpha, u.yz);
@@ -213,6 +241,7 @@ fn base_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample
         wi = r.xyz;
         if (wi.z >= 0.0) {
             return none;
+        }
         }
     }
     let pdf = base_pdf(m, wo, wi, eta);

@@ -89,6 +89,7 @@ struct TextureRef {
 const MAT_ALPHA_MASK: u32 = 1u;
 const MAT_ALPHA_BLEND: u32 = 2u;
 const MAT_DOUBLE_SIDED: u32 = 4u;
+const MAT_THIN_WALLED: u32 = 8u;
 
 struct Material {
     base_color: vec3<f32>,

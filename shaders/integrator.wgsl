@@ -114,7 +114,8 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
         // Surfaces are two-sided: face both normals towards the incoming ray. `eta` is the
         // relative index of refraction for light crossing from the ray's side.
         let ng = select(ng_raw, -ng_raw, cos_hit > 0.0);
-        let eta = select(1.0 / m.ior, m.ior, cos_hit < 0.0);
+        // A thin wall has air on both sides.
+        let eta = select(1.0 / m.ior, m.ior, cos_hit < 0.0 || (m.flags & MAT_THIN_WALLED) != 0u);
         var ns = shading_normal(tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, m, uv);
         ns = select(ns, -ns, dot(ns, ray.dir) > 0.0);
         let frame = frame_from_normal(ns);

@@ -43,6 +43,17 @@ fn plastic(base: f32, roughness: f32) -> Material {
     Material { base_color: Vec3::new(base, base * 0.8, base * 0.6), metallic: 0.0, roughness, ..Material::default() }
 }
 
+fn thin(roughness: f32, transmission: f32) -> PackedMaterial {
+    pack_material(&Material {
+        base_color: Vec3::new(1.0, 0.9, 0.8),
+        metallic: 0.0,
+        roughness,
+        transmission,
+        thin_walled: true,
+        ..Material::default()
+    })
+}
+
 fn glass(roughness: f32, transmission: f32) -> PackedMaterial {
     pack_material(&Material { base_color: Vec3::ONE, metallic: 0.0, roughness, transmission, ..Material::default() })
 }
@@ -62,6 +73,9 @@ fn cases() -> Vec<(String, PackedMaterial, f32)> {
         v.push((format!("glass leaving r={r}"), glass(r, 1.0), 1.0 / 1.5));
     }
     v.push(("half-transmissive r=0.4".to_string(), glass(0.4, 0.5), 1.5));
+    // Thin walls (no volume): seen from either side the sheet has air behind it (η = ior).
+    v.push(("thin glass r=0.4".to_string(), thin(0.4, 1.0), 1.5));
+    v.push(("thin half-transmissive r=0.7".to_string(), thin(0.7, 0.5), 1.5));
     v.push(("coat r=0.3 over plastic".to_string(), coated(plastic(0.5, 0.6), 0.3, 0.0), 1.5));
     v.push((
         "coat r=0.5 tilted over metal".to_string(),
@@ -136,7 +150,8 @@ fn sampled_albedo_equals_quadrature() {
                     let wi = direction(c, p);
                     let fc = (bsdf_eval(&m, wo, wi, eta) * c.abs()).as_dvec3();
                     quad += fc;
-                    energy += fc.y * if c < 0.0 { (eta * eta) as f64 } else { 1.0 };
+                    let thin_wall = m.flags & veach::packed::MAT_THIN_WALLED != 0;
+                    energy += fc.y * if c < 0.0 && !thin_wall { (eta * eta) as f64 } else { 1.0 };
                 }
             }
             let scale = 4.0 * std::f64::consts::PI / (nc * np) as f64;
@@ -298,5 +313,30 @@ fn a_smooth_coat_is_a_mirror_of_its_fresnel_weight() {
         let mirror = 2.0 * wo.dot(nc) * nc - wo;
         assert_eq!(bsdf_eval(&m, wo, mirror, 1.5), Vec3::ZERO);
         assert_eq!(bsdf_pdf(&m, wo, mirror, 1.5), 0.0);
+    }
+}
+
+/// A smooth thin wall lets light straight through (wi = −wo) with 1 − F of the sheet's ior,
+/// as a Dirac lobe: no bending, no 1/η² (the light leaves into the medium it came from).
+#[test]
+fn a_smooth_thin_wall_passes_light_straight_through() {
+    use veach::cpu::bsdf::fresnel_dielectric;
+    let m = thin(0.0, 1.0);
+    let mut rng = Lcg(9);
+    for theta_o in [0f32, 30.0, 60.0, 80.0] {
+        let t = theta_o.to_radians();
+        let wo = Vec3::new(t.sin(), 0.0, t.cos());
+        let (n, mut through) = (20_000, 0.0f64);
+        for _ in 0..n {
+            let s = bsdf_sample(&m, wo, Vec3::new(rng.f(), rng.f(), rng.f()), 1.5);
+            assert!(s.delta && s.pdf > 0.0, "θo={theta_o}: {s:?}");
+            if s.wi.z < 0.0 {
+                assert!((s.wi + wo).length() < 1e-6, "θo={theta_o}: {} bent from {}", s.wi, -wo);
+                through += s.weight.x as f64;
+            }
+        }
+        let expected = 1.0 - fresnel_dielectric(wo.z, 1.5) as f64;
+        let got = through / n as f64;
+        assert!((got - expected).abs() < 0.01 * expected, "θo={theta_o}: transmitted {got}, 1 − F = {expected}");
     }
 }

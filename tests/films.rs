@@ -56,7 +56,8 @@ fn features_scene() -> PathBuf {
         "metallicFactor": 0, "roughnessFactor": 0.4}, "alphaMode": "BLEND"}));
     let glass = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0,
         "roughnessFactor": 0.1}, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
-        "KHR_materials_volume": {"attenuationColor": [0.3, 0.6, 1.0], "attenuationDistance": 0.5}}}));
+        "KHR_materials_volume": {"attenuationColor": [0.3, 0.6, 1.0], "attenuationDistance": 0.5,
+        "thicknessFactor": 1.0}}}));
     let lamp = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]},
         "emissiveFactor": [4, 4, 4]}));
     let floor = b.mesh(&MeshData::quad(-3.0, -3.0, 3.0, 3.0, -1.0, MeshData::UPRIGHT), masked);

@@ -53,7 +53,8 @@ fn scene(name: &str, placements: &[serde_json::Value], shared: bool) -> PathBuf 
         b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [8, 8, 8]}));
     let glass = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.8, 1.0, 1], "metallicFactor": 0,
         "roughnessFactor": 0.2}, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
-        "KHR_materials_volume": {"attenuationColor": [0.2, 0.5, 1.0], "attenuationDistance": 0.5}}}));
+        "KHR_materials_volume": {"attenuationColor": [0.2, 0.5, 1.0], "attenuationDistance": 0.5,
+        "thicknessFactor": 1.0}}}));
     let floor = b.mesh(&MeshData::quad(-6.0, -6.0, 6.0, 6.0, 0.0, MeshData::UPRIGHT), grey);
     b.node(json!({"mesh": floor, "rotation": Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2).to_array()}));
     // The light faces down from y = 5.

@@ -250,6 +250,7 @@ fn shared_constants_have_the_same_values() {
         ("MAT_ALPHA_MASK", p::MAT_ALPHA_MASK as f64),
         ("MAT_ALPHA_BLEND", p::MAT_ALPHA_BLEND as f64),
         ("MAT_DOUBLE_SIDED", p::MAT_DOUBLE_SIDED as f64),
+        ("MAT_THIN_WALLED", p::MAT_THIN_WALLED as f64),
         ("NO_TEXTURE", p::NO_TEXTURE as f64),
         ("TEX_SRGB", p::TEX_SRGB as f64),
         ("INSTANCE_MIRRORED", p::INSTANCE_MIRRORED as f64),

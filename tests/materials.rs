@@ -364,8 +364,8 @@ fn glass_furnace(roughness: f32) -> PathBuf {
         &format!("glass-{roughness}"),
         json!({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0,
         "roughnessFactor": roughness}, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
-        "KHR_materials_ior": {"ior": 1.5}}}),
-        &["KHR_materials_transmission", "KHR_materials_ior"],
+        "KHR_materials_ior": {"ior": 1.5}, "KHR_materials_volume": {"thicknessFactor": 1.0}}}),
+        &["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"],
     )
 }
 
@@ -562,6 +562,47 @@ fn glass_in_a_furnace_neither_creates_nor_loses_energy() {
             let (gm, gv) = film_stats(gpu);
             let a = agreement(&gm, &gv, &cm, &cv);
             assert!(a.mean_z.abs().max_element() < 5.0, "glass r={roughness}: GPU vs CPU {a:?}");
+        }
+    }
+}
+
+/// KHR_materials_transmission without KHR_materials_volume is thin-walled: an emitter's edge
+/// seen through a smooth pane turned 45° stays where it is (a solid slab would shift it), and
+/// the light through is the emitter's times 1 − F(45°) of ior 1.5, computed here.
+#[test]
+fn thin_walled_panes_do_not_bend_light() {
+    let d = dir("pane");
+    let mut b = GltfBuilder::new(&d, "pane");
+    b.use_extension("KHR_materials_transmission");
+    let glow =
+        b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [1, 1, 1]}));
+    let pane = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0,
+        "roughnessFactor": 0}, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}}}));
+    let backdrop = b.mesh(&MeshData::quad(-5.0, -5.0, 0.0, 5.0, -2.0, MeshData::UPRIGHT), glow);
+    let sheet = b.mesh(&MeshData::quad(-1.0, -1.0, 1.0, 1.0, 0.0, MeshData::UPRIGHT), pane);
+    b.node(json!({"mesh": backdrop}));
+    b.node(json!({"mesh": sheet, "rotation": Quat::from_rotation_y(std::f32::consts::FRAC_PI_4).to_array()}));
+    camera_for(&mut b, 3.0, 0.15, 2.0);
+    let path = b.write();
+    let (scene, _) = common::load_pair(&path, None).unwrap();
+    assert!(scene.materials[1].thin_walled, "no volume: thin-walled");
+    let c = std::f64::consts::FRAC_1_SQRT_2;
+    let (n, eta) = (1.5f64, 1.5f64);
+    let ct = (1.0 - (1.0 - c * c) / (eta * eta)).sqrt();
+    let rs = ((c - n * ct) / (c + n * ct)).powi(2);
+    let rp = ((n * c - ct) / (n * c + ct)).powi(2);
+    let through = 1.0 - 0.5 * (rs + rp);
+    let (w, h) = (64u32, 32u32);
+    for (backend, film) in render_both(&path, &settings(w, h, 4), 16, "pane") {
+        let column = |x: u32| (0..h).map(|y| film.mean((y * w + x) as usize).y as f64).sum::<f64>() / h as f64;
+        // The edge is between columns 31 and 32; two columns each side away from it.
+        for x in [24, 28, 29] {
+            let v = column(x);
+            assert!((v - through).abs() < 0.01, "{backend}: column {x} is {v}, expected 1 − F = {through}");
+        }
+        for x in [34, 35, 40] {
+            let v = column(x);
+            assert!(v < 1e-3, "{backend}: column {x} is {v}: the edge moved right");
         }
     }
 }

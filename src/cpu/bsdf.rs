@@ -6,7 +6,7 @@ use super::microfacet::{ggx_d, ggx_g1, ggx_g2, ggx_reflection_pdf, ggx_sample_vn
 use super::sampling::{
     UNIFORM_HEMISPHERE_PDF, cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere,
 };
-use crate::packed::{Material, luminance};
+use crate::packed::{MAT_THIN_WALLED, Material, luminance};
 use crate::sheen::{sheen_albedo, sheen_albedo_scaling, sheen_brdf};
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::FRAC_1_PI;
@@ -103,6 +103,13 @@ pub fn refraction_half_vector(wo: Vec3, wi: Vec3, eta: f32) -> Vec4 {
     h.extend(d * d)
 }
 
+/// Thin-walled transmission continues a microfacet reflection through the sheet: the
+/// reflected direction mirrored in the tangent plane (and back).
+#[inline]
+pub fn thin_reflection(w: Vec3) -> Vec3 {
+    Vec3::new(w.x, w.y, -w.z)
+}
+
 pub fn refract_dir(wo: Vec3, n: Vec3, eta: f32) -> Vec4 {
     let cos_i = n.dot(wo);
     let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
@@ -121,6 +128,13 @@ pub fn base_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
     if wi.z < 0.0 {
         if alpha < DELTA_ALPHA || m.transmission <= 0.0 {
             return Vec3::ZERO;
+        }
+        if m.flags & MAT_THIN_WALLED != 0 {
+            let r = thin_reflection(wi);
+            let h = (wo + r).normalize();
+            let f = fresnel_dielectric(wo.dot(h), eta);
+            let ft = ggx_d(h, alpha) * ggx_g2(wo, r, alpha) * (1.0 - f) / (4.0 * wo.z * r.z);
+            return (1.0 - m.metallic) * m.transmission * Vec3::from(m.base_color) * ft;
         }
         let hd = refraction_half_vector(wo, wi, eta);
         if hd.w <= 0.0 {
@@ -151,6 +165,10 @@ pub fn base_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
     if wi.z < 0.0 {
         if alpha < DELTA_ALPHA || p.z <= 0.0 {
             return 0.0;
+        }
+        if m.flags & MAT_THIN_WALLED != 0 {
+            let r = thin_reflection(wi);
+            return p.z * ggx_reflection_pdf(wo, (wo + r).normalize(), alpha);
         }
         let hd = refraction_half_vector(wo, wi, eta);
         if hd.w <= 0.0 {
@@ -191,20 +209,33 @@ pub fn base_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
         if p.z <= 0.0 {
             return none;
         }
-        let h = if alpha >= DELTA_ALPHA { ggx_sample_vndf(wo, alpha, Vec2::new(u.y, u.z)) } else { Vec3::Z };
-        let r = refract_dir(wo, h, eta);
-        if r.w == 0.0 {
-            return none;
+        if m.flags & MAT_THIN_WALLED != 0 {
+            if alpha < DELTA_ALPHA {
+                let t = transmission_albedo(m, wo.z, eta);
+                return BsdfSample { wi: -wo, weight: t / p.z, pdf: p.z, delta: true };
+            }
+            let h = ggx_sample_vndf(wo, alpha, Vec2::new(u.y, u.z));
+            let r = 2.0 * wo.dot(h) * h - wo;
+            if r.z <= 0.0 {
+                return none;
+            }
+            thin_reflection(r)
+        } else {
+            let h = if alpha >= DELTA_ALPHA { ggx_sample_vndf(wo, alpha, Vec2::new(u.y, u.z)) } else { Vec3::Z };
+            let r = refract_dir(wo, h, eta);
+            if r.w == 0.0 {
+                return none;
+            }
+            if alpha < DELTA_ALPHA {
+                let t = transmission_albedo(m, wo.z, eta) / (eta * eta);
+                return BsdfSample { wi: r.truncate(), weight: t / p.z, pdf: p.z, delta: true };
+            }
+            let wi = r.truncate();
+            if wi.z >= 0.0 {
+                return none;
+            }
+            wi
         }
-        if alpha < DELTA_ALPHA {
-            let t = transmission_albedo(m, wo.z, eta) / (eta * eta);
-            return BsdfSample { wi: r.truncate(), weight: t / p.z, pdf: p.z, delta: true };
-        }
-        let wi = r.truncate();
-        if wi.z >= 0.0 {
-            return none;
-        }
-        wi
     };
     let pdf = base_pdf(m, wo, wi, eta);
     if wi.z == 0.0 || pdf <= 0.0 {

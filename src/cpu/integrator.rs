@@ -12,7 +12,7 @@ use super::material::{coat_normal, material_at, shading_normal, triangle_uv};
 use super::mis::mis_weight;
 use super::sampler::{Sampler, sample_1d, sample_2d};
 use crate::Strategy;
-use crate::packed::{Material, NO_TEXTURE, PackedScene, TRI_MIRRORED};
+use crate::packed::{MAT_THIN_WALLED, Material, NO_TEXTURE, PackedScene, TRI_MIRRORED};
 use crate::params::{LIGHT_SAMPLER_TREE, Params};
 use glam::{UVec2, Vec3};
 
@@ -130,7 +130,8 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
         }
 
         let ng = if cos_hit > 0.0 { -ng_raw } else { ng_raw };
-        let eta = if cos_hit < 0.0 { m.ior } else { 1.0 / m.ior };
+        // A thin wall has air on both sides.
+        let eta = if cos_hit < 0.0 || m.flags & MAT_THIN_WALLED != 0 { m.ior } else { 1.0 / m.ior };
         let mut ns = shading_normal(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, m, uv);
         if ns.dot(ray.dir) > 0.0 {
             ns = -ns;

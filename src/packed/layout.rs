@@ -70,6 +70,8 @@ pub const TEX_SRGB: u32 = 16;
 pub const MAT_ALPHA_MASK: u32 = 1;
 pub const MAT_ALPHA_BLEND: u32 = 2;
 pub const MAT_DOUBLE_SIDED: u32 = 4;
+/// Thin-walled transmission: light passes through without bending (and no volume inside).
+pub const MAT_THIN_WALLED: u32 = 8;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]

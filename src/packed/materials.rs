@@ -2,8 +2,8 @@
 //! dielectric Fresnel terms of KHR_materials_ior/_specular folded in.
 
 use super::layout::{
-    MAT_ALPHA_BLEND, MAT_ALPHA_MASK, MAT_DOUBLE_SIDED, Material as PackedMaterial, NO_TEXTURE, TEX_SRGB,
-    TextureRef as PackedTextureRef,
+    MAT_ALPHA_BLEND, MAT_ALPHA_MASK, MAT_DOUBLE_SIDED, MAT_THIN_WALLED, Material as PackedMaterial, NO_TEXTURE,
+    TEX_SRGB, TextureRef as PackedTextureRef,
 };
 use crate::scene::{AlphaMode, Material, TextureRef};
 use glam::Vec3;
@@ -21,7 +21,11 @@ pub fn pack_material(m: &Material) -> PackedMaterial {
     if m.double_sided {
         flags |= MAT_DOUBLE_SIDED;
     }
-    let attenuation = if m.attenuation_distance.is_finite() {
+    let thin = m.thin_walled && m.transmission > 0.0;
+    if thin {
+        flags |= MAT_THIN_WALLED;
+    }
+    let attenuation = if m.attenuation_distance.is_finite() && !thin {
         m.attenuation_color.max(Vec3::splat(1e-6)).map(|c| -c.ln() / m.attenuation_distance)
     } else {
         Vec3::ZERO

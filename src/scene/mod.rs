@@ -122,6 +122,10 @@ pub struct Material {
     /// KHR_materials_transmission.transmissionFactor: the share of the non-metal part that
     /// refracts instead of scattering diffusely.
     pub transmission: f32,
+    /// Thin-walled transmission (KHR_materials_transmission without KHR_materials_volume, or
+    /// with thicknessFactor 0): transmitted light passes through without bending, as through
+    /// a sheet with no inside.
+    pub thin_walled: bool,
     /// KHR_materials_volume: the color white light reaches after `attenuation_distance` inside.
     pub attenuation_color: Vec3,
     pub attenuation_distance: f32,
@@ -171,6 +175,7 @@ impl Default for Material {
             alpha_mode: AlphaMode::Opaque,
             double_sided: false,
             transmission: 0.0,
+            thin_walled: false,
             attenuation_color: Vec3::ONE,
             attenuation_distance: f32::INFINITY,
             base_color_texture: None,
