@@ -126,7 +126,7 @@ pub fn convert_material(
         double_sided: m.double_sided(),
         transmission: sane(m.transmission().map_or(0.0, |t| t.transmission_factor()), 0.0, 1.0, 0.0),
         // The volume's thickness decides thin or thick; only a positive one makes a solid.
-        thin_walled: m.volume().is_none_or(|v| !(v.thickness_factor() > 0.0)),
+        thin_walled: m.volume().is_none_or(|v| v.thickness_factor().is_nan() || v.thickness_factor() <= 0.0),
         attenuation_color,
         attenuation_distance: if attenuation_distance.is_finite() && attenuation_distance > 0.0 {
             attenuation_distance
