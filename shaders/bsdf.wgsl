@@ -107,6 +107,57 @@ fn refraction_half_vector(wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec4<f32> {
     return vec4<f32>(h, d * d);
 }
 
+// KHR_materials_anisotropy's roughness along and across its direction: the extension's
+// α_t = mix(α, 1, strength²), α_b = α (at least DELTA_ALPHA: a mirror stretched along the
+// tangent is rough along it and nearly smooth across).
+fn anisotropy_alphas(m: Material, alpha: f32) -> vec2<f32> {
+    return vec2<f32>(alpha + (1.0 - alpha) * m.anisotropy * m.anisotropy, max(alpha, DELTA_ALPHA));
+}
+
+// Is the specular lobe a GGX lobe (else a mirror)? An anisotropic one is as soon as its long
+// axis is rough.
+fn specular_is_rough(m: Material, alpha: f32) -> bool {
+    return alpha >= DELTA_ALPHA || (ANISOTROPY && m.anisotropy > 0.0 && anisotropy_alphas(m, alpha).x >= DELTA_ALPHA);
+}
+
+// Local frame → the frame whose x is the anisotropy direction (a turn about the normal).
+fn to_anisotropy(m: Material, w: vec3<f32>) -> vec3<f32> {
+    let t = m.anisotropy_tangent;
+    return vec3<f32>(t.x * w.x + t.y * w.y, -t.y * w.x + t.x * w.y, w.z);
+}
+
+fn from_anisotropy(m: Material, w: vec3<f32>) -> vec3<f32> {
+    let t = m.anisotropy_tangent;
+    return vec3<f32>(t.x * w.x - t.y * w.y, t.y * w.x + t.x * w.y, w.z);
+}
+
+// The specular lobe's D·G2/(4 cos θo cos θi), isotropic or anisotropic.
+fn specular_brdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, h: vec3<f32>, alpha: f32) -> f32 {
+    if (!ANISOTROPY || m.anisotropy <= 0.0) {
+        return ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) / (4.0 * wo.z * wi.z);
+    }
+    let a = anisotropy_alphas(m, alpha);
+    let o = to_anisotropy(m, wo);
+    let i = to_anisotropy(m, wi);
+    return ggx_d_aniso(to_anisotropy(m, h), a.x, a.y) * ggx_g2_aniso(o, i, a.x, a.y) / (4.0 * wo.z * wi.z);
+}
+
+fn specular_pdf(m: Material, wo: vec3<f32>, h: vec3<f32>, alpha: f32) -> f32 {
+    if (!ANISOTROPY || m.anisotropy <= 0.0) {
+        return ggx_reflection_pdf(wo, h, alpha);
+    }
+    let a = anisotropy_alphas(m, alpha);
+    return ggx_reflection_pdf_aniso(to_anisotropy(m, wo), to_anisotropy(m, h), a.x, a.y);
+}
+
+fn sample_specular_normal(m: Material, wo: vec3<f32>, alpha: f32, u: vec2<f32>) -> vec3<f32> {
+    if (!ANISOTROPY || m.anisotropy <= 0.0) {
+        return ggx_sample_vndf(wo, alpha, u);
+    }
+    let a = anisotropy_alphas(m, alpha);
+    return from_anisotropy(m, ggx_sample_vndf_aniso(to_anisotropy(m, wo), a.x, a.y, u));
+}
+
 // Thin-walled transmission continues a microfacet reflection through the sheet: the reflected
 // direction mirrored in the tangent plane (and back).
 fn thin_reflection(w: vec3<f32>) -> vec3<f32> {
@@ -153,9 +204,9 @@ fn base_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec3<f32> {
         return (1.0 - m.metallic) * m.transmission * m.base_color * ft;
     }
     var f = diffuse_albedo(m, wo.z, eta) * INV_PI;
-    if (alpha >= DELTA_ALPHA) {
+    if (specular_is_rough(m, alpha)) {
         let h = normalize(wo + wi);
-        let spec = ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) / (4.0 * wo.z * wi.z);
+        let spec = specular_brdf(m, wo, wi, h, alpha);
         f += bsdf_fresnel(m, dot(wo, h), eta) * spec;
     }
     return f;
@@ -184,8 +235,8 @@ fn base_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> f32 {
         return p.z * d_wo * abs(dot(wi, h)) / hd.w;
     }
     var pdf = p.y * cosine_hemisphere_pdf(wi.z);
-    if (alpha >= DELTA_ALPHA && p.x > 0.0) {
-        pdf += p.x * ggx_reflection_pdf(wo, normalize(wo + wi), alpha);
+    if (specular_is_rough(m, alpha) && p.x > 0.0) {
+        pdf += p.x * specular_pdf(m, wo, normalize(wo + wi), alpha);
     }
     return pdf;
 }
@@ -199,11 +250,11 @@ fn base_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample
     let alpha = m.roughness * m.roughness;
     var wi: vec3<f32>;
     if (u.x < p.x) {
-        if (alpha < DELTA_ALPHA) {
+        if (!specular_is_rough(m, alpha)) {
             let mirror = vec3<f32>(-wo.x, -wo.y, wo.z);
             return BsdfSample(mirror, bsdf_fresnel(m, wo.z, eta) / p.x, p.x, true);
         }
-        let h = ggx_sample_vndf(wo, alpha, u.yz);
+        let h = sample_specular_normal(m, wo, alpha, u.yz);
         wi = 2.0 * dot(wo, h) * h - wo;
         // A reflection below the horizon is a lost sample (pdf below counts transmission only).
         if (wi.z <= 0.0) {

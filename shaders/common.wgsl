@@ -20,6 +20,7 @@ override TRANSMISSION: bool = true;
 override INSTANCING: bool = true;
 override CLEARCOAT: bool = true;
 override SHEEN: bool = true;
+override ANISOTROPY: bool = true;
 
 struct BvhNode {
     min: vec3<f32>,
@@ -114,10 +115,15 @@ struct Material {
     sheen_roughness: f32,
     // The coat's normal in the local shading frame: (0, 0, 1) in the buffer, set per hit.
     coat_normal: vec3<f32>,
-    pad0: f32,
+    // KHR_materials_anisotropy's strength (0: isotropic).
+    anisotropy: f32,
     // ((ior − 1)/(ior + 1))² × specularColor before clamping, for specular textures.
     specular_f0: vec3<f32>,
-    pad1: f32,
+    pad0: f32,
+    // (cos, sin) of the anisotropy's rotation, and its direction in the local frame's xy
+    // plane ((1, 0) in the buffer, set per hit).
+    anisotropy_rotation: vec2<f32>,
+    anisotropy_tangent: vec2<f32>,
     base_color_texture: TextureRef,
     metallic_roughness_texture: TextureRef,
     emissive_texture: TextureRef,
@@ -130,6 +136,7 @@ struct Material {
     clearcoat_normal_texture: TextureRef,
     sheen_color_texture: TextureRef,
     sheen_roughness_texture: TextureRef,
+    anisotropy_texture: TextureRef,
 }
 
 // KHR_lights_punctual, four rows of the light-data buffer each.

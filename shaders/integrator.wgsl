@@ -127,6 +127,16 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
             nc = select(nc, -nc, dot(nc, ray.dir) > 0.0);
             m.coat_normal = to_local(frame, nc);
         }
+        // Anisotropy turns with the tangent frame; without tangents the lobe stays isotropic.
+        if (ANISOTROPY && m.anisotropy > 0.0) {
+            let d = to_local(frame, anisotropy_direction(tri, hit.tri, hit.instance, hit.u, hit.v, ns, m, uv));
+            let len = sqrt(d.x * d.x + d.y * d.y);
+            if (len > 1e-6) {
+                m.anisotropy_tangent = d.xy / len;
+            } else {
+                m.anisotropy = 0.0;
+            }
+        }
 
         // Next-event estimation: one light sample. With the BSDF strategy alone it still
         // runs for the tree's Dirac lights, which nothing else can find.

@@ -56,7 +56,46 @@ fn material_at(m: Material, uv: vec2<f32>) -> Material {
     if (TEXTURES && SHEEN && m.sheen_roughness_texture.layer != NO_TEXTURE) {
         r.sheen_roughness = m.sheen_roughness * sample_texture(m.sheen_roughness_texture, uv).w;
     }
+    if (TEXTURES && ANISOTROPY && m.anisotropy_texture.layer != NO_TEXTURE) {
+        r.anisotropy = m.anisotropy * sample_texture(m.anisotropy_texture, uv).z;
+    }
     return r;
+}
+
+// KHR_materials_anisotropy's direction at the point (world space): the tangent frame (vertex
+// tangents Gram-Schmidt'd against the shading normal n) turned by the texture's direction (RG
+// in [−1, 1]) and the rotation. Zero without tangents.
+fn anisotropy_direction(
+    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, n: vec3<f32>, m: Material, uv: vec2<f32>
+) -> vec3<f32> {
+    if ((tri.flags & TRI_HAS_TANGENTS) == 0u) {
+        return vec3<f32>(0.0);
+    }
+    let a = load_attributes(index);
+    var t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12.x) + v * oct_decode(a.t12.y);
+    if (INSTANCING) {
+        t_interp = transform_dir(load_instance(instance).object_to_world, t_interp);
+    }
+    let t_ortho = t_interp - n * dot(n, t_interp);
+    let len2 = dot(t_ortho, t_ortho);
+    if (len2 <= 1e-12) {
+        return vec3<f32>(0.0);
+    }
+    let t = t_ortho * inverseSqrt(len2);
+    var w = select(1.0, -1.0, ((tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1u) != 0u);
+    if ((tri.flags & TRI_MIRRORED) != 0u) {
+        w = -w;
+    }
+    let b = cross(n, t) * w;
+    var d = vec2<f32>(1.0, 0.0);
+    if (TEXTURES && m.anisotropy_texture.layer != NO_TEXTURE) {
+        let e = sample_texture(m.anisotropy_texture, uv).xy * 2.0 - 1.0;
+        if (dot(e, e) > 1e-8) {
+            d = normalize(e);
+        }
+    }
+    let r = m.anisotropy_rotation;
+    return t * (r.x * d.x - r.y * d.y) + b * (r.y * d.x + r.x * d.y);
 }
 
 // Does a ray stop at this triangle? MASK: alpha at or above the cutoff. BLEND: with

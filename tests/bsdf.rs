@@ -73,6 +73,15 @@ fn cases() -> Vec<(String, PackedMaterial, f32)> {
         v.push((format!("glass leaving r={r}"), glass(r, 1.0), 1.0 / 1.5));
     }
     v.push(("half-transmissive r=0.4".to_string(), glass(0.4, 0.5), 1.5));
+    // KHR_materials_anisotropy: the lobe stretched along a direction turned from the frame's x.
+    for (name, base, strength, tangent) in [
+        ("aniso metal s=0.8 r=0.4", Material { metallic: 1.0, ..plastic(0.9, 0.4) }, 0.8, [0.6, 0.8]),
+        ("aniso plastic s=0.5 r=0.3", plastic(0.5, 0.3), 0.5, [1.0, 0.0]),
+    ] {
+        let mut m = pack_material(&Material { anisotropy: strength, ..base });
+        m.anisotropy_tangent = tangent;
+        v.push((name.to_string(), m, 1.5));
+    }
     // Thin walls (no volume): seen from either side the sheet has air behind it (η = ior).
     v.push(("thin glass r=0.4".to_string(), thin(0.4, 1.0), 1.5));
     v.push(("thin half-transmissive r=0.7".to_string(), thin(0.7, 0.5), 1.5));
@@ -186,8 +195,13 @@ fn sampled_albedo_equals_quadrature() {
 #[test]
 fn near_mirror_ggx_is_finite() {
     let mut rng = Lcg(11);
-    for roughness in [0.0101, 0.0106, 0.012, 0.016] {
-        for m in [material(0.9, 1.0, roughness, 1.0), material(0.5, 0.0, roughness, 1.0), glass(roughness, 1.0)] {
+    for roughness in [0.0, 0.0101, 0.0106, 0.012, 0.016] {
+        // A stretched mirror (anisotropy over roughness 0): rough along, nearly smooth across.
+        let mut stretched = material(0.9, 1.0, roughness, 1.0);
+        (stretched.anisotropy, stretched.anisotropy_tangent) = (0.7, [0.6, 0.8]);
+        for m in
+            [material(0.9, 1.0, roughness, 1.0), material(0.5, 0.0, roughness, 1.0), glass(roughness, 1.0), stretched]
+        {
             for k in 0..20_000 {
                 // Half of the directions within 0.01 rad of the normal, where D peaks.
                 let spread = if k % 2 == 0 { 0.01 } else { 1.0 };
@@ -339,4 +353,37 @@ fn a_smooth_thin_wall_passes_light_straight_through() {
         let got = through / n as f64;
         assert!((got - expected).abs() < 0.01 * expected, "θo={theta_o}: transmitted {got}, 1 − F = {expected}");
     }
+}
+
+/// Anisotropy stretches the lobe along its direction: at normal incidence the sampled
+/// reflections' spread is widest along the anisotropy tangent (an eigenvector of their
+/// second moments, within 3°), and wider than across it by far at strength 0.9.
+#[test]
+fn anisotropy_stretches_the_lobe_along_its_direction() {
+    let base = Material { metallic: 1.0, ..plastic(0.9, 0.3) };
+    let mut m = pack_material(&Material { anisotropy: 0.9, ..base });
+    let phi = 0.7f32;
+    m.anisotropy_tangent = [phi.cos(), phi.sin()];
+    let wo = Vec3::Z;
+    let mut rng = Lcg(31);
+    let (mut sxx, mut syy, mut sxy) = (0.0f64, 0.0f64, 0.0f64);
+    for _ in 0..50_000 {
+        let s = bsdf_sample(&m, wo, Vec3::new(rng.f(), rng.f(), rng.f()), 1.5);
+        if s.pdf > 0.0 {
+            let (x, y) = (s.wi.x as f64, s.wi.y as f64);
+            sxx += x * x;
+            syy += y * y;
+            sxy += x * y;
+        }
+    }
+    // Major axis of the 2×2 moment matrix.
+    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let (c, s) = (angle.cos(), angle.sin());
+    let along = c * c * sxx + 2.0 * c * s * sxy + s * s * syy;
+    let across = s * s * sxx - 2.0 * c * s * sxy + c * c * syy;
+    let off = ((angle - phi as f64 + std::f64::consts::FRAC_PI_2).rem_euclid(std::f64::consts::PI)
+        - std::f64::consts::FRAC_PI_2)
+        .abs();
+    assert!(off < 3f64.to_radians(), "lobe's long axis at {angle} rad, anisotropy direction at {phi}");
+    assert!(along > 4.0 * across, "spread along {along} vs across {across}");
 }

@@ -146,9 +146,11 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
                 sheen_color,
                 sheen_roughness,
                 coat_normal,
-                pad0,
+                anisotropy,
                 specular_f0,
-                pad1,
+                pad0,
+                anisotropy_rotation,
+                anisotropy_tangent,
                 base_color_texture,
                 metallic_roughness_texture,
                 emissive_texture,
@@ -160,7 +162,8 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
                 clearcoat_roughness_texture,
                 clearcoat_normal_texture,
                 sheen_color_texture,
-                sheen_roughness_texture
+                sheen_roughness_texture,
+                anisotropy_texture
             }),
         ),
         ("LightEntry", rust_layout!(LightEntry { triangle, alias_slot, prob, pmf })),
@@ -306,6 +309,7 @@ fn every_override_the_host_sets_exists_in_the_kernel() {
         instancing: true,
         clearcoat: true,
         sheen: true,
+        anisotropy: true,
     };
     for (entry, extra) in [(shaders::INTEGRATOR, None), (shaders::TRACE, Some("TRACE_KIND"))] {
         for geometry in [Geometry::Buffers, Geometry::Textures] {

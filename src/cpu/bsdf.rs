@@ -2,7 +2,10 @@
 //! transmission), under KHR_materials_sheen's sheen and KHR_materials_clearcoat's coat.
 
 use super::clearcoat::{coat_alpha, coat_eval, coat_pdf, coat_sample, coat_weight};
-use super::microfacet::{ggx_d, ggx_g1, ggx_g2, ggx_reflection_pdf, ggx_sample_vndf};
+use super::microfacet::{
+    ggx_d, ggx_d_aniso, ggx_g1, ggx_g2, ggx_g2_aniso, ggx_reflection_pdf, ggx_reflection_pdf_aniso, ggx_sample_vndf,
+    ggx_sample_vndf_aniso,
+};
 use super::sampling::{
     UNIFORM_HEMISPHERE_PDF, cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere,
 };
@@ -103,6 +106,63 @@ pub fn refraction_half_vector(wo: Vec3, wi: Vec3, eta: f32) -> Vec4 {
     h.extend(d * d)
 }
 
+/// KHR_materials_anisotropy's roughness along and across its direction: the extension's
+/// α_t = mix(α, 1, strength²), α_b = α (at least DELTA_ALPHA: a mirror stretched along the
+/// tangent is rough along it and nearly smooth across).
+#[inline]
+pub fn anisotropy_alphas(m: &Material, alpha: f32) -> Vec2 {
+    Vec2::new(alpha + (1.0 - alpha) * m.anisotropy * m.anisotropy, alpha.max(DELTA_ALPHA))
+}
+
+/// Is the specular lobe a GGX lobe (else a mirror)? An anisotropic one is as soon as its
+/// long axis is rough.
+#[inline]
+pub fn specular_is_rough(m: &Material, alpha: f32) -> bool {
+    alpha >= DELTA_ALPHA || (m.anisotropy > 0.0 && anisotropy_alphas(m, alpha).x >= DELTA_ALPHA)
+}
+
+/// Local frame → the frame whose x is the anisotropy direction (a turn about the normal).
+#[inline]
+pub fn to_anisotropy(m: &Material, w: Vec3) -> Vec3 {
+    let t = Vec2::from(m.anisotropy_tangent);
+    Vec3::new(t.x * w.x + t.y * w.y, -t.y * w.x + t.x * w.y, w.z)
+}
+
+#[inline]
+pub fn from_anisotropy(m: &Material, w: Vec3) -> Vec3 {
+    let t = Vec2::from(m.anisotropy_tangent);
+    Vec3::new(t.x * w.x - t.y * w.y, t.y * w.x + t.x * w.y, w.z)
+}
+
+/// The specular lobe's D·G2/(4 cos θo cos θi), isotropic or anisotropic.
+#[inline]
+pub fn specular_brdf(m: &Material, wo: Vec3, wi: Vec3, h: Vec3, alpha: f32) -> f32 {
+    if m.anisotropy <= 0.0 {
+        return ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) / (4.0 * wo.z * wi.z);
+    }
+    let a = anisotropy_alphas(m, alpha);
+    let (o, i, h) = (to_anisotropy(m, wo), to_anisotropy(m, wi), to_anisotropy(m, h));
+    ggx_d_aniso(h, a.x, a.y) * ggx_g2_aniso(o, i, a.x, a.y) / (4.0 * wo.z * wi.z)
+}
+
+#[inline]
+pub fn specular_pdf(m: &Material, wo: Vec3, h: Vec3, alpha: f32) -> f32 {
+    if m.anisotropy <= 0.0 {
+        return ggx_reflection_pdf(wo, h, alpha);
+    }
+    let a = anisotropy_alphas(m, alpha);
+    ggx_reflection_pdf_aniso(to_anisotropy(m, wo), to_anisotropy(m, h), a.x, a.y)
+}
+
+#[inline]
+pub fn sample_specular_normal(m: &Material, wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
+    if m.anisotropy <= 0.0 {
+        return ggx_sample_vndf(wo, alpha, u);
+    }
+    let a = anisotropy_alphas(m, alpha);
+    from_anisotropy(m, ggx_sample_vndf_aniso(to_anisotropy(m, wo), a.x, a.y, u))
+}
+
 /// Thin-walled transmission continues a microfacet reflection through the sheet: the
 /// reflected direction mirrored in the tangent plane (and back).
 #[inline]
@@ -148,9 +208,9 @@ pub fn base_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
         return (1.0 - m.metallic) * m.transmission * Vec3::from(m.base_color) * ft;
     }
     let mut f = diffuse_albedo(m, wo.z, eta) * FRAC_1_PI;
-    if alpha >= DELTA_ALPHA {
+    if specular_is_rough(m, alpha) {
         let h = (wo + wi).normalize();
-        let spec = ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) / (4.0 * wo.z * wi.z);
+        let spec = specular_brdf(m, wo, wi, h, alpha);
         f += bsdf_fresnel(m, wo.dot(h), eta) * spec;
     }
     f
@@ -179,8 +239,8 @@ pub fn base_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
         return p.z * d_wo * wi.dot(h).abs() / hd.w;
     }
     let mut pdf = p.y * cosine_hemisphere_pdf(wi.z);
-    if alpha >= DELTA_ALPHA && p.x > 0.0 {
-        pdf += p.x * ggx_reflection_pdf(wo, (wo + wi).normalize(), alpha);
+    if specular_is_rough(m, alpha) && p.x > 0.0 {
+        pdf += p.x * specular_pdf(m, wo, (wo + wi).normalize(), alpha);
     }
     pdf
 }
@@ -193,11 +253,11 @@ pub fn base_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
     let p = lobe_probabilities(m, wo.z, eta);
     let alpha = m.roughness * m.roughness;
     let wi = if u.x < p.x {
-        if alpha < DELTA_ALPHA {
+        if !specular_is_rough(m, alpha) {
             let mirror = Vec3::new(-wo.x, -wo.y, wo.z);
             return BsdfSample { wi: mirror, weight: bsdf_fresnel(m, wo.z, eta) / p.x, pdf: p.x, delta: true };
         }
-        let h = ggx_sample_vndf(wo, alpha, Vec2::new(u.y, u.z));
+        let h = sample_specular_normal(m, wo, alpha, Vec2::new(u.y, u.z));
         let wi = 2.0 * wo.dot(h) * h - wo;
         if wi.z <= 0.0 {
             return none;

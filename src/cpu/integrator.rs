@@ -8,7 +8,7 @@ use super::frame::{Frame, frame_from_normal, from_local, to_local};
 use super::instance::world_triangle;
 use super::light_tree::LightContext;
 use super::lights::{LightSample, light_pdf, sample_light, sample_punctual};
-use super::material::{coat_normal, material_at, shading_normal, triangle_uv};
+use super::material::{anisotropy_direction, coat_normal, material_at, shading_normal, triangle_uv};
 use super::mis::mis_weight;
 use super::sampler::{Sampler, sample_1d, sample_2d};
 use crate::Strategy;
@@ -147,6 +147,17 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
                 nc = -nc;
             }
             mat.coat_normal = to_local(&frame, nc).into();
+        }
+        // Anisotropy turns with the tangent frame; without tangents the lobe stays isotropic.
+        if mat.anisotropy > 0.0 {
+            let d =
+                to_local(&frame, anisotropy_direction(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ns, &mat, uv));
+            let len = (d.x * d.x + d.y * d.y).sqrt();
+            if len > 1e-6 {
+                mat.anisotropy_tangent = [d.x / len, d.y / len];
+            } else {
+                mat.anisotropy = 0.0;
+            }
         }
         let m = &mat;
 

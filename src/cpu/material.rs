@@ -58,7 +58,56 @@ pub fn material_at(scene: &PackedScene, m: &Material, uv: Vec2) -> Material {
     if m.sheen_roughness_texture.layer != NO_TEXTURE {
         r.sheen_roughness = m.sheen_roughness * sample_texture(scene, &m.sheen_roughness_texture, uv).w;
     }
+    if m.anisotropy_texture.layer != NO_TEXTURE {
+        r.anisotropy = m.anisotropy * sample_texture(scene, &m.anisotropy_texture, uv).z;
+    }
     r
+}
+
+/// KHR_materials_anisotropy's direction at the point (world space): the tangent frame (vertex
+/// tangents Gram-Schmidt'd against the shading normal `n`) turned by the texture's direction
+/// (RG in [−1, 1]) and the rotation. Zero without tangents.
+#[allow(clippy::too_many_arguments)]
+pub fn anisotropy_direction(
+    scene: &PackedScene,
+    tri: &Triangle,
+    index: u32,
+    instance: u32,
+    u: f32,
+    v: f32,
+    n: Vec3,
+    m: &Material,
+    uv: Vec2,
+) -> Vec3 {
+    if tri.flags & TRI_HAS_TANGENTS == 0 {
+        return Vec3::ZERO;
+    }
+    let a = &scene.attributes[index as usize];
+    let mut t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12[0]) + v * oct_decode(a.t12[1]);
+    if scene.instance_count > 0 {
+        t_interp = transform_dir(&load_instance(scene, instance).object_to_world, t_interp);
+    }
+    let t_ortho = t_interp - n * n.dot(t_interp);
+    let len2 = t_ortho.dot(t_ortho);
+    if len2 <= 1e-12 {
+        return Vec3::ZERO;
+    }
+    let t = t_ortho / len2.sqrt();
+    let mut w = if (tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1 != 0 { -1.0 } else { 1.0 };
+    if tri.flags & TRI_MIRRORED != 0 {
+        w = -w;
+    }
+    let b = n.cross(t) * w;
+    let mut d = Vec2::X;
+    if m.anisotropy_texture.layer != NO_TEXTURE {
+        let c = sample_texture(scene, &m.anisotropy_texture, uv);
+        let e = Vec2::new(c.x, c.y) * 2.0 - Vec2::ONE;
+        if e.dot(e) > 1e-8 {
+            d = e.normalize();
+        }
+    }
+    let r = Vec2::from(m.anisotropy_rotation);
+    t * (r.x * d.x - r.y * d.y) + b * (r.y * d.x + r.x * d.y)
 }
 
 pub fn alpha_passes(scene: &PackedScene, index: u32, u: f32, v: f32, ray: &Ray) -> bool {

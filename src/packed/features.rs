@@ -14,11 +14,12 @@ pub struct Features {
     pub instancing: bool,
     pub clearcoat: bool,
     pub sheen: bool,
+    pub anisotropy: bool,
 }
 
 impl Features {
     /// The pipeline constants of `shaders/common.wgsl`.
-    pub fn constants(&self) -> [(&'static str, f64); 7] {
+    pub fn constants(&self) -> [(&'static str, f64); 8] {
         let f = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("ALPHA_TEST", f(self.alpha_test)),
@@ -28,6 +29,7 @@ impl Features {
             ("INSTANCING", f(self.instancing)),
             ("CLEARCOAT", f(self.clearcoat)),
             ("SHEEN", f(self.sheen)),
+            ("ANISOTROPY", f(self.anisotropy)),
         ]
     }
 }
@@ -48,6 +50,7 @@ impl PackedScene {
                 m.clearcoat_normal_texture,
                 m.sheen_color_texture,
                 m.sheen_roughness_texture,
+                m.anisotropy_texture,
             ]
             .iter()
             .any(|t| t.layer != NO_TEXTURE)
@@ -60,6 +63,7 @@ impl PackedScene {
             instancing: self.instance_count > 0,
             clearcoat: self.materials.iter().any(|m| m.clearcoat > 0.0),
             sheen: self.materials.iter().any(|m| m.sheen_color.iter().any(|&c| c > 0.0)),
+            anisotropy: self.materials.iter().any(|m| m.anisotropy > 0.0),
         }
     }
 }

@@ -106,10 +106,16 @@ pub struct Material {
     /// The coat's normal in the local shading frame. Not scene data: (0, 0, 1) in the buffer,
     /// set per hit by the integrator when the coat's normal differs from the shading normal.
     pub coat_normal: [f32; 3],
-    pub pad0: f32,
+    /// KHR_materials_anisotropy's strength (0: isotropic).
+    pub anisotropy: f32,
     /// ((ior − 1)/(ior + 1))² × specularColor before clamping, for specular textures.
     pub specular_f0: [f32; 3],
-    pub pad1: f32,
+    pub pad0: f32,
+    /// (cos, sin) of the anisotropy's rotation from the tangent.
+    pub anisotropy_rotation: [f32; 2],
+    /// The anisotropy direction in the local shading frame's xy plane. Not scene data:
+    /// (1, 0) in the buffer, set per hit by the integrator.
+    pub anisotropy_tangent: [f32; 2],
     pub base_color_texture: TextureRef,
     pub metallic_roughness_texture: TextureRef,
     pub emissive_texture: TextureRef,
@@ -122,6 +128,7 @@ pub struct Material {
     pub clearcoat_normal_texture: TextureRef,
     pub sheen_color_texture: TextureRef,
     pub sheen_roughness_texture: TextureRef,
+    pub anisotropy_texture: TextureRef,
 }
 
 /// A KHR_lights_punctual light as four rows of the light-data buffer.

@@ -50,9 +50,11 @@ pub fn pack_material(m: &Material) -> PackedMaterial {
         sheen_color: m.sheen_color.into(),
         sheen_roughness: m.sheen_roughness,
         coat_normal: [0.0, 0.0, 1.0],
-        pad0: 0.0,
+        anisotropy: m.anisotropy,
         specular_f0: specular_f0(m).into(),
-        pad1: 0.0,
+        pad0: 0.0,
+        anisotropy_rotation: [m.anisotropy_rotation.cos(), m.anisotropy_rotation.sin()],
+        anisotropy_tangent: [1.0, 0.0],
         base_color_texture: pack_texture_ref(m.base_color_texture, true),
         metallic_roughness_texture: pack_texture_ref(m.metallic_roughness_texture, false),
         emissive_texture: pack_texture_ref(m.emissive_texture, true),
@@ -65,6 +67,7 @@ pub fn pack_material(m: &Material) -> PackedMaterial {
         clearcoat_normal_texture: pack_texture_ref(m.clearcoat_normal_texture, false),
         sheen_color_texture: pack_texture_ref(m.sheen_color_texture, true),
         sheen_roughness_texture: pack_texture_ref(m.sheen_roughness_texture, false),
+        anisotropy_texture: pack_texture_ref(m.anisotropy_texture, false),
     }
 }
 

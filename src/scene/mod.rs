@@ -158,6 +158,12 @@ pub struct Material {
     pub sheen_roughness: f32,
     pub sheen_color_texture: Option<TextureRef>,
     pub sheen_roughness_texture: Option<TextureRef>,
+    /// KHR_materials_anisotropy: the specular lobe's roughness stretched along a direction
+    /// of the tangent frame, `rotation` radians counter-clockwise from the tangent (0: none).
+    /// The texture's RG is a direction in the tangent frame, its B multiplies the strength.
+    pub anisotropy: f32,
+    pub anisotropy_rotation: f32,
+    pub anisotropy_texture: Option<TextureRef>,
 }
 
 impl Default for Material {
@@ -196,6 +202,9 @@ impl Default for Material {
             sheen_roughness: 0.0,
             sheen_color_texture: None,
             sheen_roughness_texture: None,
+            anisotropy: 0.0,
+            anisotropy_rotation: 0.0,
+            anisotropy_texture: None,
         }
     }
 }

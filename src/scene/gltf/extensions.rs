@@ -13,13 +13,13 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_clearcoat",
     "KHR_materials_sheen",
     "KHR_materials_pbrSpecularGlossiness",
+    "KHR_materials_anisotropy",
 ];
 
 /// Extensions veach knows and ignores for now; files that merely use them render, with one
 /// warning each.
 const KNOWN_UNIMPLEMENTED: &[&str] = &[
     "KHR_materials_iridescence",
-    "KHR_materials_anisotropy",
     "KHR_materials_dispersion",
     "KHR_materials_variants",
     "KHR_texture_basisu",

@@ -112,6 +112,8 @@ pub fn convert_material(
         .and_then(|v| v.get("sheenColorFactor"))
         .and_then(|v| serde_json::from_value::<[f32; 3]>(v.clone()).ok())
         .map_or(Vec3::ZERO, Vec3::from);
+    let aniso = m.extension_value("KHR_materials_anisotropy");
+    let anisotropy_texture = texture(without_scale(json_info(aniso.and_then(|c| c.get("anisotropyTexture")))));
     let material = Material {
         // glTF's factors are in [0, 1]; a hostile 1e20 would overflow a path's throughput.
         base_color: sane3(Vec3::new(r, g, b)).min(Vec3::ONE),
@@ -151,6 +153,9 @@ pub fn convert_material(
         sheen_roughness: sane(number(sheen, "sheenRoughnessFactor", 0.0), 0.0, 1.0, 0.0),
         sheen_color_texture,
         sheen_roughness_texture,
+        anisotropy: sane(number(aniso, "anisotropyStrength", 0.0), 0.0, 1.0, 0.0),
+        anisotropy_rotation: sane(number(aniso, "anisotropyRotation", 0.0), -1e4, 1e4, 0.0),
+        anisotropy_texture,
     };
     let material = match m.pbr_specular_glossiness() {
         Some(sg) => {
