@@ -11,6 +11,7 @@
 #include "sampling.wgsl"
 #include "microfacet.wgsl"
 #include "clearcoat.wgsl"
+#include "iridescence.wgsl"
 #include "sheen.wgsl"
 
 struct BsdfSample {
@@ -44,14 +45,28 @@ fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 // The non-metal Fresnel: exact for transmissive materials (refraction needs the same F on
 // both sides, with total internal reflection), else Schlick with KHR_materials_specular.
 fn dielectric_fresnel(m: Material, cos_theta: f32, eta: f32) -> vec3<f32> {
+    var f: vec3<f32>;
     if (TRANSMISSION && m.transmission > 0.0) {
-        return vec3<f32>(fresnel_dielectric(cos_theta, eta));
+        f = vec3<f32>(fresnel_dielectric(cos_theta, eta));
+    } else {
+        f = fresnel_schlick(m.dielectric_f0, vec3<f32>(m.dielectric_f90), cos_theta);
     }
-    return fresnel_schlick(m.dielectric_f0, vec3<f32>(m.dielectric_f90), cos_theta);
+    if (!IRIDESCENCE || m.iridescence <= 0.0) {
+        return f;
+    }
+    return mix(f, thin_film(m, cos_theta, m.dielectric_f0), m.iridescence);
+}
+
+// KHR_materials_iridescence's film over a base of normal reflectance base_f0.
+fn thin_film(m: Material, cos_theta: f32, base_f0: vec3<f32>) -> vec3<f32> {
+    return iridescence_fresnel(1.0, m.iridescence_ior, cos_theta, m.iridescence_thickness_max, base_f0);
 }
 
 fn bsdf_fresnel(m: Material, cos_theta: f32, eta: f32) -> vec3<f32> {
-    let metal = fresnel_schlick(m.base_color, vec3<f32>(1.0), cos_theta);
+    var metal = fresnel_schlick(m.base_color, vec3<f32>(1.0), cos_theta);
+    if (IRIDESCENCE && m.iridescence > 0.0 && m.metallic > 0.0) {
+        metal = mix(metal, thin_film(m, cos_theta, m.base_color), m.iridescence);
+    }
     return mix(dielectric_fresnel(m, cos_theta, eta), metal, m.metallic);
 }
 

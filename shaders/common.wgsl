@@ -21,6 +21,7 @@ override INSTANCING: bool = true;
 override CLEARCOAT: bool = true;
 override SHEEN: bool = true;
 override ANISOTROPY: bool = true;
+override IRIDESCENCE: bool = true;
 
 struct BvhNode {
     min: vec3<f32>,
@@ -124,6 +125,12 @@ struct Material {
     // plane ((1, 0) in the buffer, set per hit).
     anisotropy_rotation: vec2<f32>,
     anisotropy_tangent: vec2<f32>,
+    // KHR_materials_iridescence: strength (0: none), film ior, thickness range (nm; the
+    // thickness at the point is iridescence_thickness_max after material_at).
+    iridescence: f32,
+    iridescence_ior: f32,
+    iridescence_thickness_min: f32,
+    iridescence_thickness_max: f32,
     base_color_texture: TextureRef,
     metallic_roughness_texture: TextureRef,
     emissive_texture: TextureRef,
@@ -137,6 +144,8 @@ struct Material {
     sheen_color_texture: TextureRef,
     sheen_roughness_texture: TextureRef,
     anisotropy_texture: TextureRef,
+    iridescence_texture: TextureRef,
+    iridescence_thickness_texture: TextureRef,
 }
 
 // KHR_lights_punctual, four rows of the light-data buffer each.

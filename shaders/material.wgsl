@@ -59,6 +59,13 @@ fn material_at(m: Material, uv: vec2<f32>) -> Material {
     if (TEXTURES && ANISOTROPY && m.anisotropy_texture.layer != NO_TEXTURE) {
         r.anisotropy = m.anisotropy * sample_texture(m.anisotropy_texture, uv).z;
     }
+    if (TEXTURES && IRIDESCENCE && m.iridescence_texture.layer != NO_TEXTURE) {
+        r.iridescence = m.iridescence * sample_texture(m.iridescence_texture, uv).x;
+    }
+    if (TEXTURES && IRIDESCENCE && m.iridescence_thickness_texture.layer != NO_TEXTURE) {
+        let t = sample_texture(m.iridescence_thickness_texture, uv).y;
+        r.iridescence_thickness_max = mix(m.iridescence_thickness_min, m.iridescence_thickness_max, t);
+    }
     return r;
 }
 

@@ -82,6 +82,15 @@ fn cases() -> Vec<(String, PackedMaterial, f32)> {
         m.anisotropy_tangent = tangent;
         v.push((name.to_string(), m, 1.5));
     }
+    // KHR_materials_iridescence: a film over plastic and over metal.
+    let film =
+        |base: Material| Material { iridescence: 1.0, iridescence_ior: 1.3, iridescence_thickness_max: 350.0, ..base };
+    v.push(("iridescent plastic r=0.4".to_string(), pack_material(&film(plastic(0.5, 0.4))), 1.5));
+    v.push((
+        "iridescent metal r=0.3".to_string(),
+        pack_material(&film(Material { metallic: 1.0, ..plastic(0.9, 0.3) })),
+        1.5,
+    ));
     // Thin walls (no volume): seen from either side the sheet has air behind it (η = ior).
     v.push(("thin glass r=0.4".to_string(), thin(0.4, 1.0), 1.5));
     v.push(("thin half-transmissive r=0.7".to_string(), thin(0.7, 0.5), 1.5));
@@ -386,4 +395,32 @@ fn anisotropy_stretches_the_lobe_along_its_direction() {
         .abs();
     assert!(off < 3f64.to_radians(), "lobe's long axis at {angle} rad, anisotropy direction at {phi}");
     assert!(along > 4.0 * across, "spread along {along} vs across {across}");
+}
+
+/// The thin film of KHR_materials_iridescence: a vanishing film reflects at normal incidence
+/// what the base does (the film's ior fades to the outside's; the fit's harmonics leave
+/// < 0.01); a 350 nm film of ior 1.3 colours the
+/// reflection (its channels differ by more than a tenth at some angle) and stays in [0, 1]
+/// at every angle, thickness and base.
+#[test]
+fn thin_films_fade_to_the_base_and_stay_in_range() {
+    use veach::cpu::iridescence::iridescence_fresnel;
+    for f0 in [0.04f32, 0.2, 0.9] {
+        let got = iridescence_fresnel(1.0, 1.3, 1.0, 0.0, Vec3::splat(f0));
+        assert!((got - Vec3::splat(f0)).abs().max_element() < 0.01, "f0 {f0}: {got} at normal incidence");
+    }
+    let mut spread = 0.0f32;
+    for i in 0..=20 {
+        let c = i as f32 / 20.0;
+        for thickness in [50.0f32, 200.0, 350.0, 800.0] {
+            for base in [Vec3::splat(0.04), Vec3::new(0.9, 0.6, 0.3)] {
+                let f = iridescence_fresnel(1.0, 1.3, c, thickness, base);
+                assert!(f.min_element() >= 0.0 && f.max_element() <= 1.0 && f.is_finite(), "{f}");
+                if thickness == 350.0 {
+                    spread = spread.max(f.max_element() - f.min_element());
+                }
+            }
+        }
+    }
+    assert!(spread > 0.1, "a 350 nm film does not colour its reflection (spread {spread})");
 }

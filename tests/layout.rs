@@ -151,6 +151,10 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
                 pad0,
                 anisotropy_rotation,
                 anisotropy_tangent,
+                iridescence,
+                iridescence_ior,
+                iridescence_thickness_min,
+                iridescence_thickness_max,
                 base_color_texture,
                 metallic_roughness_texture,
                 emissive_texture,
@@ -163,7 +167,9 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
                 clearcoat_normal_texture,
                 sheen_color_texture,
                 sheen_roughness_texture,
-                anisotropy_texture
+                anisotropy_texture,
+                iridescence_texture,
+                iridescence_thickness_texture
             }),
         ),
         ("LightEntry", rust_layout!(LightEntry { triangle, alias_slot, prob, pmf })),
@@ -310,6 +316,7 @@ fn every_override_the_host_sets_exists_in_the_kernel() {
         clearcoat: true,
         sheen: true,
         anisotropy: true,
+        iridescence: true,
     };
     for (entry, extra) in [(shaders::INTEGRATOR, None), (shaders::TRACE, Some("TRACE_KIND"))] {
         for geometry in [Geometry::Buffers, Geometry::Textures] {

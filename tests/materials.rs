@@ -400,6 +400,11 @@ fn layered_materials_in_a_furnace_gain_nothing_and_agree_across_engines() {
         ),
         ("sheen", json!({"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1], "sheenRoughnessFactor": 0.5}}), 0.9),
         (
+            "iridescent",
+            json!({"KHR_materials_iridescence": {"iridescenceFactor": 1.0, "iridescenceThicknessMaximum": 350.0}}),
+            0.9,
+        ),
+        (
             "coat-and-sheen",
             json!({"KHR_materials_clearcoat": {"clearcoatFactor": 0.7, "clearcoatRoughnessFactor": 0.3},
                 "KHR_materials_sheen": {"sheenColorFactor": [0.9, 0.6, 0.3], "sheenRoughnessFactor": 0.3}}),
@@ -407,8 +412,11 @@ fn layered_materials_in_a_furnace_gain_nothing_and_agree_across_engines() {
         ),
     ];
     for (name, ext, min_mean) in cases {
-        let path =
-            furnace_of(name, white(ext), &["KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen"]);
+        let path = furnace_of(
+            name,
+            white(ext),
+            &["KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_iridescence"],
+        );
         let loaded = veach::load(&path, None).unwrap();
         assert!(loaded.warnings.is_empty(), "{name}: {:?}", loaded.warnings);
         let s = Settings { width: 48, height: 48, max_depth: 0, env_color: Some([1.0; 3]), ..Settings::default() };

@@ -2,6 +2,7 @@
 //! transmission), under KHR_materials_sheen's sheen and KHR_materials_clearcoat's coat.
 
 use super::clearcoat::{coat_alpha, coat_eval, coat_pdf, coat_sample, coat_weight};
+use super::iridescence::iridescence_fresnel;
 use super::microfacet::{
     ggx_d, ggx_d_aniso, ggx_g1, ggx_g2, ggx_g2_aniso, ggx_reflection_pdf, ggx_reflection_pdf_aniso, ggx_sample_vndf,
     ggx_sample_vndf_aniso,
@@ -46,15 +47,29 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 
 #[inline]
 pub fn dielectric_fresnel(m: &Material, cos_theta: f32, eta: f32) -> Vec3 {
-    if m.transmission > 0.0 {
-        return Vec3::splat(fresnel_dielectric(cos_theta, eta));
+    let f = if m.transmission > 0.0 {
+        Vec3::splat(fresnel_dielectric(cos_theta, eta))
+    } else {
+        fresnel_schlick(m.dielectric_f0.into(), Vec3::splat(m.dielectric_f90), cos_theta)
+    };
+    if m.iridescence <= 0.0 {
+        return f;
     }
-    fresnel_schlick(m.dielectric_f0.into(), Vec3::splat(m.dielectric_f90), cos_theta)
+    f.lerp(thin_film(m, cos_theta, m.dielectric_f0.into()), m.iridescence)
+}
+
+/// KHR_materials_iridescence's film over a base of normal reflectance `base_f0`.
+#[inline]
+pub fn thin_film(m: &Material, cos_theta: f32, base_f0: Vec3) -> Vec3 {
+    iridescence_fresnel(1.0, m.iridescence_ior, cos_theta, m.iridescence_thickness_max, base_f0)
 }
 
 #[inline]
 pub fn bsdf_fresnel(m: &Material, cos_theta: f32, eta: f32) -> Vec3 {
-    let metal = fresnel_schlick(m.base_color.into(), Vec3::ONE, cos_theta);
+    let mut metal = fresnel_schlick(m.base_color.into(), Vec3::ONE, cos_theta);
+    if m.iridescence > 0.0 && m.metallic > 0.0 {
+        metal = metal.lerp(thin_film(m, cos_theta, m.base_color.into()), m.iridescence);
+    }
     dielectric_fresnel(m, cos_theta, eta).lerp(metal, m.metallic)
 }
 

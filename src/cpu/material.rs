@@ -61,6 +61,14 @@ pub fn material_at(scene: &PackedScene, m: &Material, uv: Vec2) -> Material {
     if m.anisotropy_texture.layer != NO_TEXTURE {
         r.anisotropy = m.anisotropy * sample_texture(scene, &m.anisotropy_texture, uv).z;
     }
+    if m.iridescence_texture.layer != NO_TEXTURE {
+        r.iridescence = m.iridescence * sample_texture(scene, &m.iridescence_texture, uv).x;
+    }
+    if m.iridescence_thickness_texture.layer != NO_TEXTURE {
+        let t = sample_texture(scene, &m.iridescence_thickness_texture, uv).y;
+        r.iridescence_thickness_max =
+            m.iridescence_thickness_min + (m.iridescence_thickness_max - m.iridescence_thickness_min) * t;
+    }
     r
 }
 

@@ -11,6 +11,7 @@ pub mod environment;
 pub mod frame;
 pub mod instance;
 pub mod integrator;
+pub mod iridescence;
 pub mod light_tree;
 pub mod lights;
 pub mod material;

@@ -19,6 +19,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("camera.wgsl", include_str!("../../shaders/camera.wgsl")),
     ("microfacet.wgsl", include_str!("../../shaders/microfacet.wgsl")),
     ("clearcoat.wgsl", include_str!("../../shaders/clearcoat.wgsl")),
+    ("iridescence.wgsl", include_str!("../../shaders/iridescence.wgsl")),
     ("sheen.wgsl", include_str!("../../shaders/sheen.wgsl")),
     ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
     ("environment.wgsl", include_str!("../../shaders/environment.wgsl")),

@@ -15,11 +15,12 @@ pub struct Features {
     pub clearcoat: bool,
     pub sheen: bool,
     pub anisotropy: bool,
+    pub iridescence: bool,
 }
 
 impl Features {
     /// The pipeline constants of `shaders/common.wgsl`.
-    pub fn constants(&self) -> [(&'static str, f64); 8] {
+    pub fn constants(&self) -> [(&'static str, f64); 9] {
         let f = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("ALPHA_TEST", f(self.alpha_test)),
@@ -30,6 +31,7 @@ impl Features {
             ("CLEARCOAT", f(self.clearcoat)),
             ("SHEEN", f(self.sheen)),
             ("ANISOTROPY", f(self.anisotropy)),
+            ("IRIDESCENCE", f(self.iridescence)),
         ]
     }
 }
@@ -51,6 +53,8 @@ impl PackedScene {
                 m.sheen_color_texture,
                 m.sheen_roughness_texture,
                 m.anisotropy_texture,
+                m.iridescence_texture,
+                m.iridescence_thickness_texture,
             ]
             .iter()
             .any(|t| t.layer != NO_TEXTURE)
@@ -64,6 +68,7 @@ impl PackedScene {
             clearcoat: self.materials.iter().any(|m| m.clearcoat > 0.0),
             sheen: self.materials.iter().any(|m| m.sheen_color.iter().any(|&c| c > 0.0)),
             anisotropy: self.materials.iter().any(|m| m.anisotropy > 0.0),
+            iridescence: self.materials.iter().any(|m| m.iridescence > 0.0),
         }
     }
 }

@@ -116,6 +116,12 @@ pub struct Material {
     /// The anisotropy direction in the local shading frame's xy plane. Not scene data:
     /// (1, 0) in the buffer, set per hit by the integrator.
     pub anisotropy_tangent: [f32; 2],
+    /// KHR_materials_iridescence: strength (0: none), film ior, thickness range (nm); the
+    /// thickness at a point is `iridescence_thickness_max` after `material_at`.
+    pub iridescence: f32,
+    pub iridescence_ior: f32,
+    pub iridescence_thickness_min: f32,
+    pub iridescence_thickness_max: f32,
     pub base_color_texture: TextureRef,
     pub metallic_roughness_texture: TextureRef,
     pub emissive_texture: TextureRef,
@@ -129,6 +135,8 @@ pub struct Material {
     pub sheen_color_texture: TextureRef,
     pub sheen_roughness_texture: TextureRef,
     pub anisotropy_texture: TextureRef,
+    pub iridescence_texture: TextureRef,
+    pub iridescence_thickness_texture: TextureRef,
 }
 
 /// A KHR_lights_punctual light as four rows of the light-data buffer.

@@ -55,6 +55,10 @@ pub fn pack_material(m: &Material) -> PackedMaterial {
         pad0: 0.0,
         anisotropy_rotation: [m.anisotropy_rotation.cos(), m.anisotropy_rotation.sin()],
         anisotropy_tangent: [1.0, 0.0],
+        iridescence: m.iridescence,
+        iridescence_ior: m.iridescence_ior,
+        iridescence_thickness_min: m.iridescence_thickness_min,
+        iridescence_thickness_max: m.iridescence_thickness_max,
         base_color_texture: pack_texture_ref(m.base_color_texture, true),
         metallic_roughness_texture: pack_texture_ref(m.metallic_roughness_texture, false),
         emissive_texture: pack_texture_ref(m.emissive_texture, true),
@@ -68,6 +72,8 @@ pub fn pack_material(m: &Material) -> PackedMaterial {
         sheen_color_texture: pack_texture_ref(m.sheen_color_texture, true),
         sheen_roughness_texture: pack_texture_ref(m.sheen_roughness_texture, false),
         anisotropy_texture: pack_texture_ref(m.anisotropy_texture, false),
+        iridescence_texture: pack_texture_ref(m.iridescence_texture, false),
+        iridescence_thickness_texture: pack_texture_ref(m.iridescence_thickness_texture, false),
     }
 }
 

@@ -164,6 +164,16 @@ pub struct Material {
     pub anisotropy: f32,
     pub anisotropy_rotation: f32,
     pub anisotropy_texture: Option<TextureRef>,
+    /// KHR_materials_iridescence: a thin dielectric film of this strength (0: none), ior and
+    /// thickness (nm, from `thickness_min` to `thickness_max` by the thickness texture's
+    /// green; `thickness_max` without it) over the specular lobe. Red of
+    /// `iridescence_texture` multiplies the strength.
+    pub iridescence: f32,
+    pub iridescence_ior: f32,
+    pub iridescence_thickness_min: f32,
+    pub iridescence_thickness_max: f32,
+    pub iridescence_texture: Option<TextureRef>,
+    pub iridescence_thickness_texture: Option<TextureRef>,
 }
 
 impl Default for Material {
@@ -205,6 +215,12 @@ impl Default for Material {
             anisotropy: 0.0,
             anisotropy_rotation: 0.0,
             anisotropy_texture: None,
+            iridescence: 0.0,
+            iridescence_ior: 1.3,
+            iridescence_thickness_min: 100.0,
+            iridescence_thickness_max: 400.0,
+            iridescence_texture: None,
+            iridescence_thickness_texture: None,
         }
     }
 }

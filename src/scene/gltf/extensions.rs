@@ -14,17 +14,13 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_sheen",
     "KHR_materials_pbrSpecularGlossiness",
     "KHR_materials_anisotropy",
+    "KHR_materials_iridescence",
 ];
 
 /// Extensions veach knows and ignores for now; files that merely use them render, with one
 /// warning each.
-const KNOWN_UNIMPLEMENTED: &[&str] = &[
-    "KHR_materials_iridescence",
-    "KHR_materials_dispersion",
-    "KHR_materials_variants",
-    "KHR_texture_basisu",
-    "EXT_texture_webp",
-];
+const KNOWN_UNIMPLEMENTED: &[&str] =
+    &["KHR_materials_dispersion", "KHR_materials_variants", "KHR_texture_basisu", "EXT_texture_webp"];
 
 /// Required extensions veach cannot honour are an error naming them; used ones it does not
 /// know get one warning each.

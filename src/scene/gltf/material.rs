@@ -112,6 +112,10 @@ pub fn convert_material(
         .and_then(|v| v.get("sheenColorFactor"))
         .and_then(|v| serde_json::from_value::<[f32; 3]>(v.clone()).ok())
         .map_or(Vec3::ZERO, Vec3::from);
+    let irid = m.extension_value("KHR_materials_iridescence");
+    let iridescence_texture = texture(without_scale(json_info(irid.and_then(|c| c.get("iridescenceTexture")))));
+    let iridescence_thickness_texture =
+        texture(without_scale(json_info(irid.and_then(|c| c.get("iridescenceThicknessTexture")))));
     let aniso = m.extension_value("KHR_materials_anisotropy");
     let anisotropy_texture = texture(without_scale(json_info(aniso.and_then(|c| c.get("anisotropyTexture")))));
     let material = Material {
@@ -156,6 +160,12 @@ pub fn convert_material(
         anisotropy: sane(number(aniso, "anisotropyStrength", 0.0), 0.0, 1.0, 0.0),
         anisotropy_rotation: sane(number(aniso, "anisotropyRotation", 0.0), -1e4, 1e4, 0.0),
         anisotropy_texture,
+        iridescence: sane(number(irid, "iridescenceFactor", 0.0), 0.0, 1.0, 0.0),
+        iridescence_ior: sane(number(irid, "iridescenceIor", 1.3), 1.0, 10.0, 1.3),
+        iridescence_thickness_min: sane(number(irid, "iridescenceThicknessMinimum", 100.0), 0.0, 1e5, 100.0),
+        iridescence_thickness_max: sane(number(irid, "iridescenceThicknessMaximum", 400.0), 0.0, 1e5, 400.0),
+        iridescence_texture,
+        iridescence_thickness_texture,
     };
     let material = match m.pbr_specular_glossiness() {
         Some(sg) => {

@@ -70,9 +70,10 @@ pub fn load_mesh(
         }
         let material = prim.material().index().map_or(default_material, |i| i as u32);
         // Tangent frames for what reads them: normal maps (the base's or the coat's) and anisotropy.
-        let wants_tangents = scene.materials.get(material as usize).is_some_and(|m| {
-            m.normal_texture.is_some() || m.clearcoat_normal_texture.is_some() || m.anisotropy > 0.0
-        });
+        let wants_tangents = scene
+            .materials
+            .get(material as usize)
+            .is_some_and(|m| m.normal_texture.is_some() || m.clearcoat_normal_texture.is_some() || m.anisotropy > 0.0);
         // Tangents: the file's (a direction: transformed by the upper 3×3; a mirroring
         // transform flips the bitangent's handedness), else generated from UVs.
         let tangents: Option<Vec<Vec4>> = match (&uvs, wants_tangents) {
