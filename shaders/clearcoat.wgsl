@@ -31,32 +31,41 @@ fn coat_alpha(m: Material) -> f32 {
 // D·G2/(4 (n_c·wo)(n_c·wi)) × (n_c·wi)/(n·wi): the integrator multiplies by the base's
 // cosine, the coat scatters by its own. Fresnel is in the mix weight; Dirac coats give 0.
 fn coat_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    let d = coat_directions(m, wo, wi);
+    if (!d.found) {
+        return 0.0;
+    }
     let alpha = coat_alpha(m);
-    if (alpha < DELTA_ALPHA || wi.z <= 0.0) {
-        return 0.0;
-    }
-    let frame = frame_from_normal(m.coat_normal);
-    let o = to_local(frame, wo);
-    let i = to_local(frame, wi);
-    if (o.z <= 0.0 || i.z <= 0.0) {
-        return 0.0;
-    }
-    let h = normalize(o + i);
-    return ggx_d(h, alpha) * ggx_g2(o, i, alpha) / (4.0 * o.z * wi.z);
+    return ggx_d(normalize(d.o + d.i), alpha) * ggx_g2(d.o, d.i, alpha) / (4.0 * d.o.z * wi.z);
 }
 
 fn coat_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    let alpha = coat_alpha(m);
-    if (alpha < DELTA_ALPHA || wi.z <= 0.0) {
+    let d = coat_directions(m, wo, wi);
+    if (!d.found) {
         return 0.0;
+    }
+    return ggx_reflection_pdf(d.o, normalize(d.o + d.i), coat_alpha(m));
+}
+
+struct CoatDirections {
+    o: vec3<f32>,
+    i: vec3<f32>,
+    found: bool,
+}
+
+// wo and wi in the coat's frame, when the coat is rough and both are above it and the base.
+fn coat_directions(m: Material, wo: vec3<f32>, wi: vec3<f32>) -> CoatDirections {
+    let none = CoatDirections(vec3<f32>(0.0), vec3<f32>(0.0), false);
+    if (coat_alpha(m) < DELTA_ALPHA || wi.z <= 0.0) {
+        return none;
     }
     let frame = frame_from_normal(m.coat_normal);
     let o = to_local(frame, wo);
     let i = to_local(frame, wi);
     if (o.z <= 0.0 || i.z <= 0.0) {
-        return 0.0;
+        return none;
     }
-    return ggx_reflection_pdf(o, normalize(o + i), alpha);
+    return CoatDirections(o, i, true);
 }
 
 // The mirror direction of a Dirac coat, else a reflection about a visible GGX normal;

@@ -49,7 +49,11 @@ fn iridescence_fresnel(outside: f32, film_ior: f32, cos_theta1: f32, thickness: 
     let phi12 = select(0.0, PI, film < outside);
     let phi21 = PI - phi12;
     let base_ior = fresnel0_to_ior(base_f0);
-    let r1 = vec3<f32>(ior_to_fresnel0(base_ior.x, film), ior_to_fresnel0(base_ior.y, film), ior_to_fresnel0(base_ior.z, film));
+    let r1 = vec3<f32>(
+        ior_to_fresnel0(base_ior.x, film),
+        ior_to_fresnel0(base_ior.y, film),
+        ior_to_fresnel0(base_ior.z, film),
+    );
     let r23 = vec3<f32>(schlick_film(r1.x, c2), schlick_film(r1.y, c2), schlick_film(r1.z, c2));
     let phi23 = select(vec3<f32>(0.0), vec3<f32>(PI), base_ior < vec3<f32>(film));
     let opd = 2.0 * film * thickness * c2;

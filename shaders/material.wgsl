@@ -69,14 +69,20 @@ fn material_at(m: Material, uv: vec2<f32>) -> Material {
     return r;
 }
 
-// KHR_materials_anisotropy's direction at the point (world space): the tangent frame (vertex
-// tangents Gram-Schmidt'd against the shading normal n) turned by the texture's direction (RG
-// in [−1, 1]) and the rotation. Zero without tangents.
-fn anisotropy_direction(
-    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, n: vec3<f32>, m: Material, uv: vec2<f32>
-) -> vec3<f32> {
+struct TangentFrame {
+    t: vec3<f32>,
+    b: vec3<f32>,
+    found: bool,
+}
+
+// The tangent frame at (u, v) around the unit normal n: the interpolated vertex tangent (to
+// world space with instancing) Gram-Schmidt'd against n, and the bitangent n × t times the
+// handedness of the nearest vertex (all three agree within a UV island), flipped by
+// mirroring. Not found without tangents, or when the tangent is parallel to n.
+fn tangent_frame(tri: Triangle, index: u32, instance: u32, u: f32, v: f32, n: vec3<f32>) -> TangentFrame {
+    let none = TangentFrame(vec3<f32>(0.0), vec3<f32>(0.0), false);
     if ((tri.flags & TRI_HAS_TANGENTS) == 0u) {
-        return vec3<f32>(0.0);
+        return none;
     }
     let a = load_attributes(index);
     var t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12.x) + v * oct_decode(a.t12.y);
@@ -86,14 +92,26 @@ fn anisotropy_direction(
     let t_ortho = t_interp - n * dot(n, t_interp);
     let len2 = dot(t_ortho, t_ortho);
     if (len2 <= 1e-12) {
-        return vec3<f32>(0.0);
+        return none;
     }
     let t = t_ortho * inverseSqrt(len2);
     var w = select(1.0, -1.0, ((tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1u) != 0u);
     if ((tri.flags & TRI_MIRRORED) != 0u) {
         w = -w;
     }
-    let b = cross(n, t) * w;
+    return TangentFrame(t, cross(n, t) * w, true);
+}
+
+// KHR_materials_anisotropy's direction at the point (world space): the tangent frame (vertex
+// tangents Gram-Schmidt'd against the shading normal n) turned by the texture's direction (RG
+// in [−1, 1]) and the rotation. Zero without tangents.
+fn anisotropy_direction(
+    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, n: vec3<f32>, m: Material, uv: vec2<f32>
+) -> vec3<f32> {
+    let f = tangent_frame(tri, index, instance, u, v, n);
+    if (!f.found) {
+        return vec3<f32>(0.0);
+    }
     var d = vec2<f32>(1.0, 0.0);
     if (TEXTURES && m.anisotropy_texture.layer != NO_TEXTURE) {
         let e = sample_texture(m.anisotropy_texture, uv).xy * 2.0 - 1.0;
@@ -102,7 +120,7 @@ fn anisotropy_direction(
         }
     }
     let r = m.anisotropy_rotation;
-    return t * (r.x * d.x - r.y * d.y) + b * (r.y * d.x + r.x * d.y);
+    return f.t * (r.x * d.x - r.y * d.y) + f.b * (r.y * d.x + r.x * d.y);
 }
 
 // Does a ray stop at this triangle? MASK: alpha at or above the cutoff. BLEND: with
@@ -168,27 +186,15 @@ fn mapped_normal(
         let len2 = dot(s, s);
         n = select(ng, s * inverseSqrt(len2), len2 > 0.0);
     }
-    if (!TEXTURES || (tri.flags & TRI_HAS_TANGENTS) == 0u || map.layer == NO_TEXTURE) {
+    if (!TEXTURES || map.layer == NO_TEXTURE) {
         return n;
     }
-    var t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12.x) + v * oct_decode(a.t12.y);
-    if (INSTANCING) {
-        t_interp = transform_dir(inst.object_to_world, t_interp);
-    }
-    let t_ortho = t_interp - n * dot(n, t_interp);
-    let len2 = dot(t_ortho, t_ortho);
-    if (len2 <= 1e-12) {
+    let f = tangent_frame(tri, index, instance, u, v, n);
+    if (!f.found) {
         return n;
     }
-    let t = t_ortho * inverseSqrt(len2);
-    // The handedness of the vertex nearest to the point (all three agree within an island).
-    var w = select(1.0, -1.0, ((tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1u) != 0u);
-    if ((tri.flags & TRI_MIRRORED) != 0u) {
-        w = -w;
-    }
-    let b = cross(n, t) * w;
     let c = sample_texture(map, uv).xyz * 2.0 - 1.0;
-    let mapped = t * (c.x * scale) + b * (c.y * scale) + n * c.z;
+    let mapped = f.t * (c.x * scale) + f.b * (c.y * scale) + n * c.z;
     let mlen2 = dot(mapped, mapped);
     return select(n, mapped * inverseSqrt(mlen2), mlen2 > 1e-12);
 }

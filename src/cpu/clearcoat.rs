@@ -37,30 +37,28 @@ pub fn coat_alpha(m: &Material) -> f32 {
 /// mix weight carries it. Dirac coats (α < DELTA_ALPHA) evaluate to 0.
 pub fn coat_eval(m: &Material, wo: Vec3, wi: Vec3) -> f32 {
     let alpha = coat_alpha(m);
-    if alpha < DELTA_ALPHA || wi.z <= 0.0 {
-        return 0.0;
+    match coat_directions(m, wo, wi) {
+        Some((o, i)) => ggx_d((o + i).normalize(), alpha) * ggx_g2(o, i, alpha) / (4.0 * o.z * wi.z),
+        None => 0.0,
     }
-    let frame = frame_from_normal(Vec3::from(m.coat_normal));
-    let (o, i) = (to_local(&frame, wo), to_local(&frame, wi));
-    if o.z <= 0.0 || i.z <= 0.0 {
-        return 0.0;
-    }
-    let h = (o + i).normalize();
-    ggx_d(h, alpha) * ggx_g2(o, i, alpha) / (4.0 * o.z * wi.z)
 }
 
 /// Solid-angle density of `coat_sample` (visible normals of the coat's GGX).
 pub fn coat_pdf(m: &Material, wo: Vec3, wi: Vec3) -> f32 {
-    let alpha = coat_alpha(m);
-    if alpha < DELTA_ALPHA || wi.z <= 0.0 {
-        return 0.0;
+    match coat_directions(m, wo, wi) {
+        Some((o, i)) => ggx_reflection_pdf(o, (o + i).normalize(), coat_alpha(m)),
+        None => 0.0,
+    }
+}
+
+/// wo and wi in the coat's frame, when the coat is rough and both are above it and the base.
+pub fn coat_directions(m: &Material, wo: Vec3, wi: Vec3) -> Option<(Vec3, Vec3)> {
+    if coat_alpha(m) < DELTA_ALPHA || wi.z <= 0.0 {
+        return None;
     }
     let frame = frame_from_normal(Vec3::from(m.coat_normal));
     let (o, i) = (to_local(&frame, wo), to_local(&frame, wi));
-    if o.z <= 0.0 || i.z <= 0.0 {
-        return 0.0;
-    }
-    ggx_reflection_pdf(o, (o + i).normalize(), alpha)
+    (o.z > 0.0 && i.z > 0.0).then_some((o, i))
 }
 
 /// A direction reflected by the coat: its mirror direction when it is a Dirac coat, else a

@@ -72,6 +72,40 @@ pub fn material_at(scene: &PackedScene, m: &Material, uv: Vec2) -> Material {
     r
 }
 
+/// The tangent frame at (u, v) around the unit normal `n`: the interpolated vertex tangent
+/// (to world space with instancing) Gram-Schmidt'd against n, and the bitangent n × t times
+/// the handedness of the nearest vertex (all three agree within a UV island), flipped by
+/// mirroring. None without tangents, or when the tangent is parallel to n.
+pub fn tangent_frame(
+    scene: &PackedScene,
+    tri: &Triangle,
+    index: u32,
+    instance: u32,
+    u: f32,
+    v: f32,
+    n: Vec3,
+) -> Option<(Vec3, Vec3)> {
+    if tri.flags & TRI_HAS_TANGENTS == 0 {
+        return None;
+    }
+    let a = &scene.attributes[index as usize];
+    let mut t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12[0]) + v * oct_decode(a.t12[1]);
+    if scene.instance_count > 0 {
+        t_interp = transform_dir(&load_instance(scene, instance).object_to_world, t_interp);
+    }
+    let t_ortho = t_interp - n * n.dot(t_interp);
+    let len2 = t_ortho.dot(t_ortho);
+    if len2 <= 1e-12 {
+        return None;
+    }
+    let t = t_ortho / len2.sqrt();
+    let mut w = if (tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1 != 0 { -1.0 } else { 1.0 };
+    if tri.flags & TRI_MIRRORED != 0 {
+        w = -w;
+    }
+    Some((t, n.cross(t) * w))
+}
+
 /// KHR_materials_anisotropy's direction at the point (world space): the tangent frame (vertex
 /// tangents Gram-Schmidt'd against the shading normal `n`) turned by the texture's direction
 /// (RG in [−1, 1]) and the rotation. Zero without tangents.
@@ -87,25 +121,9 @@ pub fn anisotropy_direction(
     m: &Material,
     uv: Vec2,
 ) -> Vec3 {
-    if tri.flags & TRI_HAS_TANGENTS == 0 {
+    let Some((t, b)) = tangent_frame(scene, tri, index, instance, u, v, n) else {
         return Vec3::ZERO;
-    }
-    let a = &scene.attributes[index as usize];
-    let mut t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12[0]) + v * oct_decode(a.t12[1]);
-    if scene.instance_count > 0 {
-        t_interp = transform_dir(&load_instance(scene, instance).object_to_world, t_interp);
-    }
-    let t_ortho = t_interp - n * n.dot(t_interp);
-    let len2 = t_ortho.dot(t_ortho);
-    if len2 <= 1e-12 {
-        return Vec3::ZERO;
-    }
-    let t = t_ortho / len2.sqrt();
-    let mut w = if (tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1 != 0 { -1.0 } else { 1.0 };
-    if tri.flags & TRI_MIRRORED != 0 {
-        w = -w;
-    }
-    let b = n.cross(t) * w;
+    };
     let mut d = Vec2::X;
     if m.anisotropy_texture.layer != NO_TEXTURE {
         let c = sample_texture(scene, &m.anisotropy_texture, uv);
@@ -196,24 +214,12 @@ pub fn mapped_normal(
         let len2 = s.dot(s);
         n = if len2 > 0.0 { s / len2.sqrt() } else { ng };
     }
-    if tri.flags & TRI_HAS_TANGENTS == 0 || map.layer == NO_TEXTURE {
+    if map.layer == NO_TEXTURE {
         return n;
     }
-    let mut t_interp = (1.0 - u - v) * oct_decode(a.t0) + u * oct_decode(a.t12[0]) + v * oct_decode(a.t12[1]);
-    if let Some(inst) = &inst {
-        t_interp = transform_dir(&inst.object_to_world, t_interp);
-    }
-    let t_ortho = t_interp - n * n.dot(t_interp);
-    let len2 = t_ortho.dot(t_ortho);
-    if len2 <= 1e-12 {
+    let Some((t, b)) = tangent_frame(scene, tri, index, instance, u, v, n) else {
         return n;
-    }
-    let t = t_ortho / len2.sqrt();
-    let mut w = if (tri.flags >> (TRI_TANGENT_SIGN_SHIFT + nearest_vertex(u, v))) & 1 != 0 { -1.0 } else { 1.0 };
-    if tri.flags & TRI_MIRRORED != 0 {
-        w = -w;
-    }
-    let b = n.cross(t) * w;
+    };
     let c = sample_texture(scene, map, uv).truncate() * 2.0 - Vec3::ONE;
     let mapped = t * (c.x * scale) + b * (c.y * scale) + n * c.z;
     let mlen2 = mapped.dot(mapped);
