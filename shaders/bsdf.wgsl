@@ -429,3 +429,30 @@ fn bsdf_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample
     }
     return BsdfSample(wi, bsdf_eval(m, wo, wi, eta) * (abs(wi.z) / pdf), pdf, false);
 }
+
+// Whether every lobe the material samples from wo is a Dirac one (a mirror, smooth glass, a
+// smooth thin sheet, under a smooth coat at most): the AOVs look through such surfaces.
+fn bsdf_is_delta(m: Material, wo: vec3<f32>, eta: f32) -> bool {
+    let alpha = m.roughness * m.roughness;
+    let p = lobe_probabilities(m, wo.z, eta);
+    let base = p.y <= 0.0 && (p.x <= 0.0 || !specular_is_rough(m, alpha)) && (p.z <= 0.0 || alpha < DELTA_ALPHA);
+    if (!has_layers(m)) {
+        return base;
+    }
+    let l = layer_probabilities(m, wo, eta);
+    return l.y <= 0.0 && (l.z <= 0.0 || base) && (l.x <= 0.0 || coat_alpha(m) < DELTA_ALPHA);
+}
+
+// The albedo AOV of a surface seen from wo, in [0, 1]: the base's lobes' reflectances
+// (specular Fresnel, diffuse and transmitted colour, textures included) under the sheen; a
+// clear coat absorbs nothing and is left out, as Open Image Denoise advises.
+fn bsdf_albedo(m: Material, wo: vec3<f32>, eta: f32) -> vec3<f32> {
+    let c = max(wo.z, 0.0);
+    let base = bsdf_fresnel(m, c, eta) + diffuse_albedo(m, c, eta) + transmission_albedo(m, c, eta);
+    var albedo = base;
+    if (SHEEN && max_component(m.sheen_color) > 0.0) {
+        let e = sheen_albedo(c, m.sheen_roughness);
+        albedo = m.sheen_color * e + base * (1.0 - max_component(m.sheen_color) * e);
+    }
+    return clamp(albedo, vec3<f32>(0.0), vec3<f32>(1.0));
+}

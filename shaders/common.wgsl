@@ -22,6 +22,8 @@ override CLEARCOAT: bool = true;
 override SHEEN: bool = true;
 override ANISOTROPY: bool = true;
 override IRIDESCENCE: bool = true;
+// The render accumulates AOVs (aov.wgsl); not a scene feature but a setting.
+override AOVS: bool = false;
 
 struct BvhNode {
     min: vec3<f32>,
@@ -230,9 +232,10 @@ struct Params {
     adaptive_step: u32,
     // First row of the sheen albedo table in light_data (sheen.wgsl).
     sheen_base: u32,
+    // First film row of the AOV region (aov.wgsl); 0: no AOVs.
+    aov_base: u32,
     pad0: u32,
     pad1: u32,
-    pad2: u32,
 }
 
 struct Ray {

@@ -10,6 +10,7 @@
 #include "mis.wgsl"
 #include "film.wgsl"
 #include "adaptive.wgsl"
+#include "aov.wgsl"
 #include "material.wgsl"
 
 // Do the geometric and the shading normal agree on which side `wi` leaves?
@@ -58,7 +59,8 @@ fn clamp_contribution(c: vec3<f32>, segments: u32) -> vec3<f32> {
 }
 
 // Radiance arriving along a camera ray. Path depth counts segments (Mitsuba's max_depth).
-fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
+// With AOVS, what the ray saw of the first visible surface goes into `aov` (aov.wgsl).
+fn li(camera_ray: Ray, sampler: ptr<function, Sampler>, aov: ptr<function, AovSample>) -> vec3<f32> {
     let strategy = params.strategy;
     var radiance = vec3<f32>(0.0);
     var beta = vec3<f32>(1.0);
@@ -68,6 +70,9 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
     var prev_delta = true;
     // The previous vertex as light selection saw it (for the tree's probability on a hit).
     var prev_ctx = LightContext(vec3<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0), false);
+    // The AOVs look through Dirac surfaces, weighted by the path's own throughput there.
+    var aov_open = AOVS;
+    var aov_weight = vec3<f32>(1.0);
     loop {
         let hit = intersect_closest(ray);
         depth += 1u;
@@ -107,7 +112,8 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
             }
             radiance += clamp_contribution(beta * m.emission * w, depth);
         }
-        if (params.max_depth != 0u && depth >= params.max_depth) {
+        let last = params.max_depth != 0u && depth >= params.max_depth;
+        if (last && !aov_open) {
             break;
         }
 
@@ -136,6 +142,18 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
             } else {
                 m.anisotropy = 0.0;
             }
+        }
+
+        if (aov_open) {
+            if (depth == 1u) {
+                (*aov).depth = hit.t;
+            }
+            (*aov).albedo = clamp(aov_weight * bsdf_albedo(m, wo, eta), vec3<f32>(0.0), vec3<f32>(1.0));
+            (*aov).normal = ns;
+            aov_open = bsdf_is_delta(m, wo, eta);
+        }
+        if (last) {
+            break;
         }
 
         // Next-event estimation: one light sample. With the BSDF strategy alone it still
@@ -180,6 +198,9 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>) -> vec3<f32> {
             break;
         }
         beta *= bs.weight;
+        if (aov_open) {
+            aov_weight *= bs.weight;
+        }
         if (max_component(beta) <= 0.0) {
             break;
         }
@@ -211,9 +232,13 @@ fn render_sample(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var sampler: Sampler;
     let ray = camera_sample(at.pixel, &sampler);
-    let l = li(ray, &sampler);
+    var aov = aov_none();
+    let l = li(ray, &sampler, &aov);
     film_add_sample(at.slot, l);
     if (adaptive) {
         adaptive_add_sample(at.slot, l);
+    }
+    if (AOVS) {
+        aov_add_sample(at.slot, aov);
     }
 }

@@ -95,7 +95,7 @@ mod tests {
 
     #[test]
     fn settling_dilates_unconverged_pixels_by_one() {
-        let mut film = Film::with_layout(5, 5, true);
+        let mut film = Film::with_layout(5, 5, crate::film::FilmLayout { adaptive: true, aovs: false });
         for i in 0..25 {
             let at = film.adaptive_record(i) + 3;
             film.data[at] = (i != 12) as u32; // every pixel passed but the centre

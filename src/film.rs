@@ -13,6 +13,10 @@
 //! per pixel `ADAPTIVE_WORDS` words `[Σr, Σg, Σb of its odd-numbered samples (the half
 //! buffer, f32 bits), 1 if it passed its last convergence test]`, then one word per pixel,
 //! 1 once it has converged (padded to a multiple of 4 words: the kernel reads vec4 rows).
+//!
+//! A film with AOVs (`src/aov.rs`) appends `AOV_WORDS` words per pixel after those: the sums
+//! of the albedo and the (biased) shading normal of the first visible surface and of its
+//! camera distance, in the same fixed point as the radiance.
 
 use glam::{DVec3, Vec3};
 
@@ -21,14 +25,44 @@ pub const WORDS_PER_PIXEL: usize = 12;
 /// Words per pixel of an adaptive film's half-buffer region.
 pub const ADAPTIVE_WORDS: usize = 4;
 
+/// Words per pixel of a film's AOV region (`src/aov.rs`).
+pub const AOV_WORDS: usize = 16;
+
 /// Largest radiance one sample may add (the largest f32 below 2^31).
 pub const MAX_SAMPLE: f32 = 2147483520.0;
+
+/// Which optional regions a film carries after its pixels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FilmLayout {
+    /// Adaptive sampling's half buffer and convergence flags.
+    pub adaptive: bool,
+    /// The albedo, normal and depth AOVs.
+    pub aovs: bool,
+}
+
+impl FilmLayout {
+    /// The layout a render with these parameters accumulates into.
+    pub fn of(params: &crate::params::Params) -> FilmLayout {
+        FilmLayout { adaptive: params.noise_threshold > 0.0, aovs: params.aov_base > 0 }
+    }
+
+    /// Words of the regions before the AOVs (pixels, then adaptive sampling's).
+    pub fn aov_base(self, pixels: usize) -> usize {
+        pixels * WORDS_PER_PIXEL + if self.adaptive { pixels * ADAPTIVE_WORDS + pixels.next_multiple_of(4) } else { 0 }
+    }
+
+    /// Words of a film of `pixels` pixels.
+    pub fn words(self, pixels: usize) -> usize {
+        self.aov_base(pixels) + if self.aovs { pixels * AOV_WORDS } else { 0 }
+    }
+}
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     pub width: u32,
     pub height: u32,
     pub data: Vec<u32>,
+    pub layout: FilmLayout,
 }
 
 /// A sample's value as 32.32 fixed point: (integer part, fraction × 2^32).
@@ -63,27 +97,39 @@ pub fn film_sum(p: &[u32]) -> Vec3 {
 
 impl Film {
     pub fn new(width: u32, height: u32) -> Film {
-        Film::with_layout(width, height, false)
+        Film::with_layout(width, height, FilmLayout::default())
     }
 
-    /// An empty film, with the regions of adaptive sampling when `adaptive`.
-    pub fn with_layout(width: u32, height: u32, adaptive: bool) -> Film {
+    /// An empty film with the optional regions of `layout`.
+    pub fn with_layout(width: u32, height: u32, layout: FilmLayout) -> Film {
         let n = width as usize * height as usize;
-        Film { width, height, data: vec![0; Self::words(n, adaptive)] }
-    }
-
-    fn words(pixels: usize, adaptive: bool) -> usize {
-        pixels * WORDS_PER_PIXEL + if adaptive { pixels * ADAPTIVE_WORDS + pixels.next_multiple_of(4) } else { 0 }
+        Film { width, height, data: vec![0; layout.words(n)], layout }
     }
 
     /// Bytes of a `width`×`height` film.
-    pub fn bytes(width: u32, height: u32, adaptive: bool) -> u64 {
-        Self::words(width as usize * height as usize, adaptive) as u64 * 4
+    pub fn bytes(width: u32, height: u32, layout: FilmLayout) -> u64 {
+        layout.words(width as usize * height as usize) as u64 * 4
     }
 
     /// Whether the film carries adaptive sampling's half buffer and convergence flags.
     pub fn is_adaptive(&self) -> bool {
-        self.data.len() > self.pixel_count() * WORDS_PER_PIXEL
+        self.layout.adaptive
+    }
+
+    /// Whether the film carries the albedo, normal and depth AOVs.
+    pub fn has_aovs(&self) -> bool {
+        self.layout.aovs
+    }
+
+    /// Index of pixel `i`'s AOV record in `data` (films with AOVs).
+    pub fn aov_record(&self, i: usize) -> usize {
+        self.layout.aov_base(self.pixel_count()) + i * AOV_WORDS
+    }
+
+    /// Pixel `i`'s AOV words (films with AOVs).
+    pub fn aov_words(&self, i: usize) -> &[u32] {
+        let at = self.aov_record(i);
+        &self.data[at..at + AOV_WORDS]
     }
 
     /// Index of pixel `i`'s half-buffer record in `data` (adaptive films).
@@ -174,6 +220,20 @@ impl Film {
         (0..self.pixel_count()).flat_map(|i| self.mean(i).to_array()).collect()
     }
 
+    /// An AOV image (row-major): three floats a pixel for the albedo and the normal, one for
+    /// the depth; None when the film has no AOVs.
+    pub fn aov_image(&self, aov: crate::aov::Aov) -> Option<Vec<f32>> {
+        use crate::aov::{Aov, aov_albedo, aov_depth, aov_normal};
+        self.has_aovs().then(|| {
+            let pixels = 0..self.pixel_count();
+            match aov {
+                Aov::Albedo => pixels.flat_map(|i| aov_albedo(self.aov_words(i), self.taken(i)).to_array()).collect(),
+                Aov::Normal => pixels.flat_map(|i| aov_normal(self.aov_words(i), self.taken(i)).to_array()).collect(),
+                Aov::Depth => pixels.map(|i| aov_depth(self.aov_words(i))).collect(),
+            }
+        })
+    }
+
     /// The variance of each pixel's mean, per channel (row-major, three floats a pixel).
     pub fn variance(&self) -> Vec<f32> {
         (0..self.pixel_count()).flat_map(|i| self.variance_of_mean(i).to_array()).collect()
@@ -201,8 +261,11 @@ impl Film {
         if self.is_adaptive() || other.is_adaptive() {
             return Err("films of adaptive renders do not merge (each pixel stopped on its own)".into());
         }
+        if self.layout != other.layout {
+            return Err("a film with AOVs does not merge with one without".into());
+        }
         let tile = crate::Tile { x, y, width: other.width, height: other.height };
-        if !tile.fits(self.width, self.height) || other.data.len() != other.pixel_count() * WORDS_PER_PIXEL {
+        if !tile.fits(self.width, self.height) || other.data.len() != other.layout.words(other.pixel_count()) {
             return Err(format!(
                 "a {}x{} film at {x},{y} does not fit in the {}x{} image",
                 other.width, other.height, self.width, self.height
@@ -221,6 +284,11 @@ impl Film {
                 }
                 p[3] = p[3].wrapping_add(src[3]);
                 p[7] = p[7].wrapping_add(src[7]);
+                if self.layout.aovs {
+                    let src = other.aov_words((oy * other.width + ox) as usize).to_vec();
+                    let at = self.aov_record(i);
+                    crate::aov::aov_merge(&mut self.data[at..at + AOV_WORDS], &src);
+                }
             }
         }
         Ok(())

@@ -24,11 +24,14 @@
 #[doc(hidden)]
 pub mod accel;
 pub mod adaptive;
+pub mod aov;
 #[cfg(feature = "bench")]
 pub mod bench;
 #[doc(hidden)]
 pub mod cpu;
+pub mod denoise;
 mod error;
+pub mod exr_layers;
 pub mod film;
 pub mod gpu;
 mod job;

@@ -40,14 +40,53 @@ fn temp_path(path: &Path) -> PathBuf {
 
 /// The film's mean, exposed, tone-mapped and sRGB-encoded.
 pub fn tonemap(film: &Film, exposure: f32, operator: Tonemap) -> image::RgbImage {
-    let mut img = image::RgbImage::new(film.width, film.height);
+    tonemap_pixels(film.width, film.height, |i| film.mean(i), exposure, operator)
+}
+
+/// Linear RGB pixels (`pixel(i)`, row-major), exposed, tone-mapped and sRGB-encoded.
+pub fn tonemap_pixels(
+    width: u32,
+    height: u32,
+    pixel: impl Fn(usize) -> glam::Vec3,
+    exposure: f32,
+    operator: Tonemap,
+) -> image::RgbImage {
+    let mut img = image::RgbImage::new(width, height);
     let scale = exposure.exp2();
     for (i, px) in img.pixels_mut().enumerate() {
-        let c = crate::tonemap::tonemap(film.mean(i) * scale, operator);
+        let c = crate::tonemap::tonemap(pixel(i) * scale, operator);
         let q = |v: f32| (crate::tonemap::srgb_encode(v) * 255.0 + 0.5) as u8;
         *px = image::Rgb([q(c.x), q(c.y), q(c.z)]);
     }
     img
+}
+
+/// Writes a linear RGB image (three floats a pixel, row-major): a tone-mapped PNG or a
+/// linear EXR of R, G and B.
+pub fn write_rgb(
+    rgb: &[f32],
+    width: u32,
+    height: u32,
+    path: &Path,
+    exposure: f32,
+    operator: Tonemap,
+) -> Result<(), Error> {
+    let pixel = |i: usize| glam::Vec3::from_slice(&rgb[i * 3..i * 3 + 3]);
+    match check_output(path)? {
+        Format::Png => write_png(&tonemap_pixels(width, height, pixel, exposure, operator), path),
+        Format::Exr => {
+            use exr::prelude::*;
+            let size = (width as usize, height as usize);
+            let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+                let c = pixel(p.y() * width as usize + p.x());
+                (c.x, c.y, c.z)
+            });
+            let image = Image::from_channels(size, channels);
+            save_atomic(path, |tmp| {
+                image.write().to_file(tmp).map_err(|e| image::ImageError::IoError(std::io::Error::other(e.to_string())))
+            })
+        }
+    }
 }
 
 /// Writes the film's image: a tone-mapped PNG, or a linear EXR that also carries the film
@@ -59,7 +98,24 @@ pub fn write(film: &Film, path: &Path, exposure: f32, job: Option<&Job>) -> Resu
 pub fn write_with(film: &Film, path: &Path, exposure: f32, operator: Tonemap, job: Option<&Job>) -> Result<(), Error> {
     match check_output(path)? {
         Format::Png => write_png(&tonemap(film, exposure, operator), path),
-        Format::Exr => write_exr(film, path, job),
+        Format::Exr => write_exr(film, path, job, None),
+    }
+}
+
+/// Writes a denoised render: a PNG of the denoised image (`denoised`: linear RGB, three
+/// floats a pixel), or the film's EXR (noisy R, G, B, the AOVs, film and job) with a
+/// `denoised` layer.
+pub fn write_denoised(
+    film: &Film,
+    denoised: &[f32],
+    path: &Path,
+    exposure: f32,
+    operator: Tonemap,
+    job: Option<&Job>,
+) -> Result<(), Error> {
+    match check_output(path)? {
+        Format::Png => write_rgb(denoised, film.width, film.height, path, exposure, operator),
+        Format::Exr => write_exr(film, path, job, Some(denoised)),
     }
 }
 
@@ -89,6 +145,34 @@ const ADAPTIVE_CHANNELS: [&str; 5] = [
     "veach.adaptive.converged",
 ];
 
+/// The AOVs' exact sums (src/aov.rs), so that renders with AOVs resume and merge exactly.
+const AOV_CHANNELS: [&str; 15] = [
+    "veach.aov.albedo.hi.R",
+    "veach.aov.albedo.hi.G",
+    "veach.aov.albedo.hi.B",
+    "veach.aov.depth.hi",
+    "veach.aov.albedo.lo.R",
+    "veach.aov.albedo.lo.G",
+    "veach.aov.albedo.lo.B",
+    "veach.aov.depth.lo",
+    "veach.aov.normal.hi.X",
+    "veach.aov.normal.hi.Y",
+    "veach.aov.normal.hi.Z",
+    "veach.aov.depth.hits",
+    "veach.aov.normal.lo.X",
+    "veach.aov.normal.lo.Y",
+    "veach.aov.normal.lo.Z",
+];
+
+/// The AOV layers as image channels: name, and the AOV's component it holds.
+fn aov_layer_channels(aov: crate::aov::Aov) -> &'static [&'static str] {
+    match aov {
+        crate::aov::Aov::Albedo => &["albedo.R", "albedo.G", "albedo.B"],
+        crate::aov::Aov::Normal => &["normal.X", "normal.Y", "normal.Z"],
+        crate::aov::Aov::Depth => &["depth.Z"],
+    }
+}
+
 /// Where word `k` of `ADAPTIVE_CHANNELS` of pixel `i` lives in an adaptive film's data.
 fn adaptive_word(film: &Film, k: usize, i: usize) -> usize {
     if k < crate::film::ADAPTIVE_WORDS { film.adaptive_record(i) + k } else { film.converged_flag(i) }
@@ -111,7 +195,7 @@ fn ascii_json(value: &serde_json::Value) -> String {
     out
 }
 
-fn write_exr(film: &Film, path: &Path, job: Option<&Job>) -> Result<(), Error> {
+fn write_exr(film: &Film, path: &Path, job: Option<&Job>, denoised: Option<&[f32]>) -> Result<(), Error> {
     use exr::prelude::*;
     let n = film.pixel_count();
     let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
@@ -132,6 +216,27 @@ fn write_exr(film: &Film, path: &Path, job: Option<&Job>) -> Result<(), Error> {
         let samples = (0..n).map(|i| film.taken(i) as f32);
         channels.push(AnyChannel::new("samples.Y", FlatSamples::F32(samples.collect())));
     }
+    if film.has_aovs() {
+        for (k, name) in AOV_CHANNELS.iter().enumerate() {
+            let words = (0..n).map(|i| film.aov_words(i)[k]);
+            channels.push(AnyChannel::new(*name, FlatSamples::U32(words.collect())));
+        }
+        // The layers asked for (all of them for a film written without its job).
+        let asked = job.map_or(crate::aov::Aov::ALL.to_vec(), |j| j.settings.aovs.clone());
+        for aov in asked {
+            let Some(image) = film.aov_image(aov) else { continue };
+            let names = aov_layer_channels(aov);
+            for (c, name) in names.iter().enumerate() {
+                let values = (0..n).map(|i| image[i * names.len() + c]);
+                channels.push(AnyChannel::new(*name, FlatSamples::F32(values.collect())));
+            }
+        }
+    }
+    if let Some(rgb) = denoised {
+        for (c, name) in ["denoised.R", "denoised.G", "denoised.B"].iter().enumerate() {
+            channels.push(AnyChannel::new(*name, FlatSamples::F32((0..n).map(|i| rgb[i * 3 + c]).collect())));
+        }
+    }
     let mut attributes = LayerAttributes::named("veach");
     let meta = serde_json::json!({ "samples": film.samples(), "job": job });
     let json = Text::new_or_none(ascii_json(&meta)).unwrap_or_else(|| Text::from("{}"));
@@ -148,7 +253,7 @@ fn write_exr(film: &Film, path: &Path, job: Option<&Job>) -> Result<(), Error> {
 /// pixel, and a failed allocation aborts the process: so the declared sizes are checked first,
 /// against the limits a veach film has (each side at most `MAX_IMAGE_SIDE`, all channels
 /// together at most `MAX_FILM_BYTES`, which a veach part of the largest film stays under).
-fn check_exr_size(path: &Path) -> Result<(), String> {
+pub(crate) fn check_exr_size(path: &Path) -> Result<(), String> {
     use crate::{MAX_FILM_BYTES, MAX_IMAGE_SIDE};
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| format!("cannot read EXR: {e}"))?;
     for header in meta.headers.iter() {
@@ -197,7 +302,7 @@ pub fn read_film(path: &Path) -> Result<(Film, Job), crate::Error> {
         return Err(fail(format!("film is {w}x{h} but its job says {}x{}", window.width, window.height)));
     }
     let adaptive = job.settings.adaptive();
-    let mut film = Film::with_layout(w as u32, h as u32, adaptive);
+    let mut film = Film::with_layout(w as u32, h as u32, job.settings.film_layout());
     let u32_channel = |name: &str| -> std::result::Result<Vec<u32>, crate::Error> {
         let channel = layer
             .channel_data
@@ -223,6 +328,14 @@ pub fn read_film(path: &Path) -> Result<(Film, Job), crate::Error> {
         for (k, name) in ADAPTIVE_CHANNELS.iter().enumerate() {
             for (i, word) in u32_channel(name)?.into_iter().enumerate() {
                 let at = adaptive_word(&film, k, i);
+                film.data[at] = word;
+            }
+        }
+    }
+    if film.has_aovs() {
+        for (k, name) in AOV_CHANNELS.iter().enumerate() {
+            for (i, word) in u32_channel(name)?.into_iter().enumerate() {
+                let at = film.aov_record(i) + k;
                 film.data[at] = word;
             }
         }
@@ -264,7 +377,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     })
 }
 
-fn save_atomic(path: &Path, save: impl FnOnce(&Path) -> image::ImageResult<()>) -> Result<(), Error> {
+pub(crate) fn save_atomic(path: &Path, save: impl FnOnce(&Path) -> image::ImageResult<()>) -> Result<(), Error> {
     let tmp = temp_path(path);
     let io = |e: String| Error::Input(format!("{}: cannot write output: {e}", path.display()));
     let result = save(&tmp);

@@ -70,7 +70,9 @@ pub struct Params {
     pub adaptive_step: u32,
     /// First row of the sheen albedo table in the light-data buffer (`src/sheen.rs`).
     pub sheen_base: u32,
-    pub pad: [u32; 3],
+    /// First film row (vec4) of the AOV region (`src/aov.rs`); 0: no AOVs.
+    pub aov_base: u32,
+    pub pad: [u32; 2],
 }
 
 /// Russian roulette starts once a path has this many segments.
@@ -139,7 +141,12 @@ impl Params {
             adaptive_min_samples: settings.adaptive_min_samples(),
             adaptive_step: crate::adaptive::ADAPTIVE_STEP,
             sheen_base: scene.sheen_base,
-            pad: [0; 3],
+            aov_base: if settings.aovs.is_empty() {
+                0
+            } else {
+                (settings.film_layout().aov_base(tile.width as usize * tile.height as usize) / 4) as u32
+            },
+            pad: [0; 2],
         }
     }
 }

@@ -254,10 +254,14 @@ impl Renderer {
                 film.width, film.height, w.width, w.height
             )));
         }
-        let adaptive = self.settings.adaptive();
-        if film.data.len() != Film::with_layout(w.width, w.height, adaptive).data.len() {
-            let (want, have) = if adaptive { ("an adaptive", "a uniform") } else { ("a uniform", "an adaptive") };
+        let layout = self.settings.film_layout();
+        if film.layout.adaptive != layout.adaptive {
+            let (want, have) =
+                if layout.adaptive { ("an adaptive", "a uniform") } else { ("a uniform", "an adaptive") };
             return Err(Error::Input(format!("the render is {want} one; the film is of {have} render")));
+        }
+        if film.layout != layout || film.data.len() != layout.words(film.pixel_count()) {
+            return Err(Error::Input("the film's AOVs do not match the render's".into()));
         }
         match &mut self.engine {
             Engine::Gpu(g, _) => g.upload_film(film),

@@ -207,6 +207,10 @@ pub struct Settings {
     /// Samples every pixel takes before adaptive sampling tests it (None: `adaptive_min_samples()`'s default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_samples: Option<u32>,
+    /// AOV layers written with the image (`src/aov.rs`); the film accumulates all three as
+    /// soon as one is asked for. Empty: none (the film has no AOV region).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub aovs: Vec<crate::aov::Aov>,
 }
 
 impl Default for Settings {
@@ -230,6 +234,7 @@ impl Default for Settings {
             clamp_indirect: None,
             noise_threshold: None,
             min_samples: None,
+            aovs: Vec::new(),
         }
     }
 }
@@ -243,6 +248,11 @@ impl Settings {
     /// Whether pixels stop sampling on their own (adaptive sampling).
     pub fn adaptive(&self) -> bool {
         self.noise_threshold.is_some()
+    }
+
+    /// The film these settings accumulate into: adaptive sampling's regions, the AOVs.
+    pub fn film_layout(&self) -> crate::film::FilmLayout {
+        crate::film::FilmLayout { adaptive: self.adaptive(), aovs: !self.aovs.is_empty() }
     }
 
     /// Samples each pixel takes before its first convergence test: as set, else
@@ -270,7 +280,7 @@ impl Settings {
                 t.x, t.y, t.width, t.height
             )));
         }
-        let film_bytes = crate::film::Film::bytes(t.width, t.height, self.adaptive());
+        let film_bytes = crate::film::Film::bytes(t.width, t.height, self.film_layout());
         if film_bytes > MAX_FILM_BYTES {
             return Err(Error::Limit(format!(
                 "a {}x{} film needs {film_bytes} bytes, above veach's limit of {MAX_FILM_BYTES} bytes; render tiles (--tile)",

@@ -59,7 +59,6 @@ const RENAMED: &[(&str, &str, &str, u32)] = &[
     ("Attributes", "uv2", "uv", 16),
     ("Params", "pad0", "pad", 0),
     ("Params", "pad1", "pad", 4),
-    ("Params", "pad2", "pad", 8),
     ("Punctual", "pad0", "pad", 0),
     ("Punctual", "pad1", "pad", 4),
     ("Punctual", "pad2", "pad", 8),
@@ -118,6 +117,7 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
                 adaptive_min_samples,
                 adaptive_step,
                 sheen_base,
+                aov_base,
                 pad
             }),
         ),
@@ -317,6 +317,7 @@ fn every_override_the_host_sets_exists_in_the_kernel() {
         sheen: true,
         anisotropy: true,
         iridescence: true,
+        aovs: true,
     };
     for (entry, extra) in [(shaders::INTEGRATOR, None), (shaders::TRACE, Some("TRACE_KIND"))] {
         for geometry in [Geometry::Buffers, Geometry::Textures] {

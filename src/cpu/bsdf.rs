@@ -427,3 +427,34 @@ pub fn bsdf_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
     }
     BsdfSample { wi, weight: bsdf_eval(m, wo, wi, eta) * (wi.z.abs() / pdf), pdf, delta: false }
 }
+
+/// Whether every lobe the material samples from `wo` is a Dirac one (a mirror, smooth glass,
+/// a smooth thin sheet, under a smooth coat at most): the AOVs look through such surfaces.
+/// Twin of `bsdf_is_delta`.
+pub fn bsdf_is_delta(m: &Material, wo: Vec3, eta: f32) -> bool {
+    let alpha = m.roughness * m.roughness;
+    let p = lobe_probabilities(m, wo.z, eta);
+    let base = p.y <= 0.0 && (p.x <= 0.0 || !specular_is_rough(m, alpha)) && (p.z <= 0.0 || alpha < DELTA_ALPHA);
+    if !has_layers(m) {
+        return base;
+    }
+    let l = layer_probabilities(m, wo, eta);
+    l.y <= 0.0 && (l.z <= 0.0 || base) && (l.x <= 0.0 || coat_alpha(m) < DELTA_ALPHA)
+}
+
+/// The albedo AOV of a surface seen from `wo`, in [0, 1]: the base's lobes' reflectances
+/// (specular Fresnel, diffuse and transmitted colour, textures included) under the sheen;
+/// a clear coat absorbs nothing and is left out, as Open Image Denoise advises.
+/// Twin of `bsdf_albedo`.
+pub fn bsdf_albedo(m: &Material, wo: Vec3, eta: f32) -> Vec3 {
+    let c = wo.z.max(0.0);
+    let base = bsdf_fresnel(m, c, eta) + diffuse_albedo(m, c, eta) + transmission_albedo(m, c, eta);
+    let sheen = Vec3::from(m.sheen_color);
+    let albedo = if sheen.max_element() > 0.0 {
+        let e = sheen_albedo(c, m.sheen_roughness);
+        sheen * e + base * (1.0 - sheen.max_element() * e)
+    } else {
+        base
+    };
+    albedo.clamp(Vec3::ZERO, Vec3::ONE)
+}

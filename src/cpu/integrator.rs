@@ -1,6 +1,6 @@
 //! Twin of `shaders/integrator.wgsl`: the path tracer, sample for sample.
 
-use super::bsdf::{bsdf_eval, bsdf_pdf, bsdf_sample};
+use super::bsdf::{bsdf_albedo, bsdf_eval, bsdf_is_delta, bsdf_pdf, bsdf_sample};
 use super::bvh::{INF, NO_HIT, Ray, intersect_closest, occluded, offset_ray};
 use super::camera::camera_sample;
 use super::environment::{environment_pdf, environment_radiance};
@@ -12,6 +12,7 @@ use super::material::{anisotropy_direction, coat_normal, material_at, shading_no
 use super::mis::mis_weight;
 use super::sampler::{Sampler, sample_1d, sample_2d};
 use crate::Strategy;
+use crate::aov::AovSample;
 use crate::packed::{MAT_THIN_WALLED, Material, NO_TEXTURE, PackedScene, TRI_MIRRORED};
 use crate::params::{LIGHT_SAMPLER_TREE, Params};
 use glam::{UVec2, Vec3};
@@ -68,7 +69,9 @@ pub fn clamp_contribution(params: &Params, c: Vec3, segments: u32) -> Vec3 {
     if sum > limit { c * (limit / sum) } else { c }
 }
 
-pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut Sampler) -> Vec3 {
+/// Radiance arriving along a camera ray; with AOVs on (`params.aov_base`), what the ray saw of
+/// the first visible surface goes into `aov` (`src/aov.rs`).
+pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut Sampler, aov: &mut AovSample) -> Vec3 {
     let strategy = Strategy::try_from(params.strategy).unwrap_or(Strategy::MisPower);
     let mut radiance = Vec3::ZERO;
     let mut beta = Vec3::ONE;
@@ -78,6 +81,9 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
     let mut prev_delta = true;
     // The previous vertex as light selection saw it (for the tree's probability on a hit).
     let mut prev_ctx = LightContext { point: Vec3::ZERO, normal: Vec3::Z, reflect_only: false };
+    // The AOVs look through Dirac surfaces, weighted by the path's own throughput there.
+    let mut aov_open = params.aov_base > 0;
+    let mut aov_weight = Vec3::ONE;
     loop {
         let hit = intersect_closest(scene, &ray);
         depth += 1;
@@ -125,7 +131,8 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
             }
             radiance += clamp_contribution(params, beta * emission * w, depth);
         }
-        if params.max_depth != 0 && depth >= params.max_depth {
+        let last = params.max_depth != 0 && depth >= params.max_depth;
+        if last && !aov_open {
             break;
         }
 
@@ -160,6 +167,17 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
             }
         }
         let m = &mat;
+        if aov_open {
+            if depth == 1 {
+                aov.depth = hit.t;
+            }
+            aov.albedo = (aov_weight * bsdf_albedo(m, wo, eta)).clamp(Vec3::ZERO, Vec3::ONE);
+            aov.normal = ns;
+            aov_open = bsdf_is_delta(m, wo, eta);
+        }
+        if last {
+            break;
+        }
 
         let ctx = LightContext { point, normal: ns, reflect_only: m.transmission <= 0.0 };
         // Next-event estimation: one light sample. With the BSDF strategy alone it still
@@ -204,6 +222,9 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
             break;
         }
         beta *= bs.weight;
+        if aov_open {
+            aov_weight *= bs.weight;
+        }
         if beta.max_element() <= 0.0 {
             break;
         }
@@ -223,9 +244,12 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
     radiance
 }
 
-/// Sample `params.sample_index` of one film pixel; returns the radiance (possibly non-finite).
-pub fn render_sample(scene: &PackedScene, params: &Params, x: u32, y: u32) -> Vec3 {
+/// Sample `params.sample_index` of one film pixel; returns the radiance (possibly non-finite)
+/// and, with AOVs on, what it saw of the first visible surface.
+pub fn render_sample(scene: &PackedScene, params: &Params, x: u32, y: u32) -> (Vec3, AovSample) {
     let pixel = UVec2::new(x + params.tile_x, y + params.tile_y);
     let (ray, mut sampler) = camera_sample(params, pixel);
-    li(scene, params, ray, &mut sampler)
+    let mut aov = AovSample::default();
+    let l = li(scene, params, ray, &mut sampler, &mut aov);
+    (l, aov)
 }

@@ -2,7 +2,8 @@
 //! of `gpu::GpuRenderer`.
 
 use crate::adaptive::{adaptive_add_sample, adaptive_settle, adaptive_test_due};
-use crate::film::{ADAPTIVE_WORDS, Film, WORDS_PER_PIXEL, film_add_sample};
+use crate::aov::aov_add_sample;
+use crate::film::{ADAPTIVE_WORDS, AOV_WORDS, Film, WORDS_PER_PIXEL, film_add_sample};
 use crate::packed::PackedScene;
 use crate::params::Params;
 use rayon::prelude::*;
@@ -16,29 +17,33 @@ pub struct Renderer {
 }
 
 fn empty_film(params: &Params) -> Film {
-    Film::with_layout(params.film_width, params.film_height, params.noise_threshold > 0.0)
+    Film::with_layout(params.film_width, params.film_height, crate::film::FilmLayout::of(params))
 }
 
-/// Samples `samples` of film row `y` into its words `row`; with adaptive sampling, `adaptive`
-/// holds the row's half-buffer records and convergence flags (converged pixels are skipped).
-fn render_row(
-    scene: &PackedScene,
-    base: &Params,
-    samples: std::ops::Range<u32>,
-    y: usize,
-    row: &mut [u32],
-    mut adaptive: Option<(&mut [u32], &[u32])>,
-) {
+/// One film row's regions: its pixels' words, and when the film has them, adaptive
+/// sampling's half-buffer records and convergence flags, and the AOV records.
+struct Row<'a> {
+    words: &'a mut [u32],
+    adaptive: Option<(&'a mut [u32], &'a [u32])>,
+    aovs: Option<&'a mut [u32]>,
+}
+
+/// Samples `samples` of film row `y` (converged pixels are skipped).
+fn render_row(scene: &PackedScene, base: &Params, samples: std::ops::Range<u32>, y: usize, row: Row) {
+    let Row { words, mut adaptive, mut aovs } = row;
     for s in samples {
         let p = Params { sample_index: s, ..*base };
-        for (x, words) in row.chunks_exact_mut(WORDS_PER_PIXEL).enumerate() {
+        for (x, words) in words.chunks_exact_mut(WORDS_PER_PIXEL).enumerate() {
             if adaptive.as_ref().is_some_and(|(_, flags)| flags[x] != 0) {
                 continue;
             }
-            let l = super::render_sample(scene, &p, x as u32, y as u32);
+            let (l, aov) = super::render_sample(scene, &p, x as u32, y as u32);
             film_add_sample(words, l);
             if let Some((records, _)) = &mut adaptive {
                 adaptive_add_sample(&p, words, &mut records[x * ADAPTIVE_WORDS..(x + 1) * ADAPTIVE_WORDS], l);
+            }
+            if let Some(records) = &mut aovs {
+                aov_add_sample(&mut records[x * AOV_WORDS..(x + 1) * AOV_WORDS], &aov);
             }
         }
     }
@@ -82,23 +87,32 @@ impl Renderer {
         let (scene, base) = (&self.scene, self.params);
         let width = base.film_width as usize;
         let pixels = self.film.pixel_count();
-        let (main, extra) = self.film.data.split_at_mut(pixels * WORDS_PER_PIXEL);
-        let (skip, take) = (rows.start, rows.len());
-        let film_rows = main.par_chunks_mut(width * WORDS_PER_PIXEL).enumerate();
-        if extra.is_empty() {
-            film_rows
-                .skip(skip)
-                .take(take)
-                .for_each(|(y, row)| render_row(scene, &base, start..start + count, y, row, None));
-        } else {
-            let (records, flags) = extra.split_at_mut(pixels * ADAPTIVE_WORDS);
-            let flags: &[u32] = flags;
-            let rows = film_rows.zip(records.par_chunks_mut(width * ADAPTIVE_WORDS)).skip(skip).take(take);
-            rows.for_each(|((y, row), rec)| {
-                let flags = &flags[y * width..(y + 1) * width];
-                render_row(scene, &base, start..start + count, y, row, Some((rec, flags)))
-            });
+        let layout = self.film.layout;
+        let (main, rest) = self.film.data.split_at_mut(pixels * WORDS_PER_PIXEL);
+        let (adaptive, aovs) = rest.split_at_mut(layout.aov_base(pixels) - pixels * WORDS_PER_PIXEL);
+        let (records, flags) = adaptive.split_at_mut(if layout.adaptive { pixels * ADAPTIVE_WORDS } else { 0 });
+        let flags: &[u32] = flags;
+        // One task a row, each with its part of every region the film has.
+        let mut tasks: Vec<Row> =
+            main.chunks_mut(width * WORDS_PER_PIXEL).map(|words| Row { words, adaptive: None, aovs: None }).collect();
+        if layout.adaptive {
+            for ((row, rec), fl) in
+                tasks.iter_mut().zip(records.chunks_mut(width * ADAPTIVE_WORDS)).zip(flags.chunks(width))
+            {
+                row.adaptive = Some((rec, fl));
+            }
         }
+        if layout.aovs {
+            for (row, a) in tasks.iter_mut().zip(aovs.chunks_mut(width * AOV_WORDS)) {
+                row.aovs = Some(a);
+            }
+        }
+        tasks
+            .into_par_iter()
+            .enumerate()
+            .skip(rows.start)
+            .take(rows.len())
+            .for_each(|(y, row)| render_row(scene, &base, start..start + count, y, row));
     }
 
     /// Accumulates sample `sample` for film rows `y0 .. y0 + rows`; the last band of a sample

@@ -1,24 +1,24 @@
 //! The film on the device: a storage buffer of `WORDS_PER_PIXEL` u32 words a pixel, and
-//! adaptive sampling's regions after them (src/film.rs), its readback buffer, and uploads
-//! for resume.
+//! adaptive sampling's and the AOVs' regions after them (src/film.rs), its readback buffer,
+//! and uploads for resume.
 
 use super::{GpuContext, check_limit};
 use crate::Error;
-use crate::film::{ADAPTIVE_WORDS, Film, WORDS_PER_PIXEL};
+use crate::film::{ADAPTIVE_WORDS, Film, FilmLayout, WORDS_PER_PIXEL};
 
 pub struct DeviceFilm {
     pub buffer: wgpu::Buffer,
     readback: wgpu::Buffer,
     pub width: u32,
     pub height: u32,
-    pub adaptive: bool,
+    pub layout: FilmLayout,
 }
 
 impl DeviceFilm {
     /// A zeroed film of `width`×`height` pixels, within the device's binding limit.
-    pub fn new(ctx: &GpuContext, width: u32, height: u32, adaptive: bool) -> Result<DeviceFilm, Error> {
+    pub fn new(ctx: &GpuContext, width: u32, height: u32, layout: FilmLayout) -> Result<DeviceFilm, Error> {
         let limits = ctx.device.limits();
-        let bytes = Film::bytes(width, height, adaptive);
+        let bytes = Film::bytes(width, height, layout);
         check_limit("film", bytes, limits.max_storage_buffer_binding_size, "max_storage_buffer_binding_size")?;
         let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("film"),
@@ -32,7 +32,7 @@ impl DeviceFilm {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Ok(DeviceFilm { buffer, readback, width, height, adaptive })
+        Ok(DeviceFilm { buffer, readback, width, height, layout })
     }
 
     /// Zeroes the film.
@@ -49,7 +49,7 @@ impl DeviceFilm {
 
     /// Copies the film back to the host.
     pub fn read(&self, ctx: &GpuContext) -> Result<Film, Error> {
-        let mut film = Film::with_layout(self.width, self.height, self.adaptive);
+        let mut film = Film::with_layout(self.width, self.height, self.layout);
         let words = self.read_words(ctx, 0, film.data.len())?;
         film.data.copy_from_slice(&words);
         Ok(film)

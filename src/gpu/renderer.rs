@@ -6,7 +6,7 @@ use super::film::DeviceFilm;
 use super::{GeometryPlacement, GpuContext, MAX_BATCH, shaders, storage_buffer};
 use crate::Error;
 use crate::adaptive::adaptive_test_due;
-use crate::film::Film;
+use crate::film::{Film, FilmLayout};
 use crate::packed::PackedScene;
 use crate::params::Params;
 
@@ -19,12 +19,12 @@ pub struct GpuRenderer {
     /// Adaptive sampling's `adaptive_settle`, dispatched after each convergence test.
     settle: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
-    #[cfg(feature = "bench")]
+    module: wgpu::ShaderModule,
     pub(super) pipeline_layout: wgpu::PipelineLayout,
     #[cfg(feature = "bench")]
     pub(super) variant: shaders::Geometry,
-    #[cfg(feature = "bench")]
-    pub(super) constants: [(&'static str, f64); 9],
+    /// The override constants the pipelines were made with (the scene's features, AOVs).
+    pub(super) constants: [(&'static str, f64); 10],
     /// `trace_rays` pipelines by TRACE_KIND, built on first use (by `veach bench` only).
     #[cfg(feature = "bench")]
     pub(super) trace_pipelines: [Option<wgpu::ComputePipeline>; 3],
@@ -92,20 +92,10 @@ impl GpuRenderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let constants = scene.features().constants();
-        let entry = |name: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(name),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(name),
-                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
-                cache: None,
-            })
-        };
-        let pipeline = entry("render_sample");
-        let settle = entry("adaptive_settle");
-        let film = DeviceFilm::new(&ctx, params.film_width, params.film_height, params.noise_threshold > 0.0)?;
+        let features = crate::packed::Features { aovs: params.aov_base > 0, ..scene.features() };
+        let constants = features.constants();
+        let (pipeline, settle) = Self::pipelines(device, &pipeline_layout, &module, &constants);
+        let film = DeviceFilm::new(&ctx, params.film_width, params.film_height, FilmLayout::of(&params))?;
         let bind_group = bindings::bind_group(device, &layout, &resources, &params_buf, &film.buffer);
         let gpu_bytes = resources.buffer_bytes() + film.buffer.size() + params_buf.size() + texture_bytes + paged_bytes;
         ctx.check()?;
@@ -114,11 +104,10 @@ impl GpuRenderer {
             pipeline,
             settle,
             layout,
-            #[cfg(feature = "bench")]
+            module,
             pipeline_layout,
             #[cfg(feature = "bench")]
             variant,
-            #[cfg(feature = "bench")]
             constants,
             #[cfg(feature = "bench")]
             trace_pipelines: [None, None, None],
@@ -133,9 +122,42 @@ impl GpuRenderer {
         })
     }
 
-    /// A new film for `params`' window and the bind group over it.
+    /// The integrator's two entry points for a set of override constants.
+    fn pipelines(
+        device: &wgpu::Device,
+        layout: &wgpu::PipelineLayout,
+        module: &wgpu::ShaderModule,
+        constants: &[(&str, f64)],
+    ) -> (wgpu::ComputePipeline, wgpu::ComputePipeline) {
+        let entry = |name: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(name),
+                layout: Some(layout),
+                module,
+                entry_point: Some(name),
+                compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+                cache: None,
+            })
+        };
+        (entry("render_sample"), entry("adaptive_settle"))
+    }
+
+    /// A new film for `params`' window and the bind group over it; the pipelines again when
+    /// the film gains or loses its AOVs (the kernel compiles them in or out).
     fn new_film(&mut self, params: Params) -> Result<(), Error> {
-        self.film = DeviceFilm::new(&self.ctx, params.film_width, params.film_height, params.noise_threshold > 0.0)?;
+        let aovs = if params.aov_base > 0 { 1.0 } else { 0.0 };
+        if let Some(c) = self.constants.iter_mut().find(|c| c.0 == "AOVS")
+            && c.1 != aovs
+        {
+            c.1 = aovs;
+            (self.pipeline, self.settle) =
+                Self::pipelines(&self.ctx.device, &self.pipeline_layout, &self.module, &self.constants);
+            #[cfg(feature = "bench")]
+            {
+                self.trace_pipelines = [None, None, None];
+            }
+        }
+        self.film = DeviceFilm::new(&self.ctx, params.film_width, params.film_height, FilmLayout::of(&params))?;
         self.bind_group =
             bindings::bind_group(&self.ctx.device, &self.layout, &self.scene, &self.params_buf, &self.film.buffer);
         Ok(())
@@ -155,8 +177,8 @@ impl GpuRenderer {
     /// New parameters (camera, settings, window) and an empty film: the viewer's restart.
     pub fn reset(&mut self, params: Params) -> Result<(), Error> {
         self.taken = 0;
-        let adaptive = params.noise_threshold > 0.0;
-        if (params.film_width, params.film_height, adaptive) != (self.film.width, self.film.height, self.film.adaptive)
+        if (params.film_width, params.film_height, FilmLayout::of(&params))
+            != (self.film.width, self.film.height, self.film.layout)
         {
             self.new_film(params)?;
         } else {
@@ -268,7 +290,7 @@ impl GpuRenderer {
 
     /// The fraction of pixels that converged (None: not adaptive).
     pub fn converged_fraction(&self) -> Result<Option<f64>, Error> {
-        if !self.film.adaptive {
+        if !self.film.layout.adaptive {
             return Ok(None);
         }
         let pixels = (self.film.width as u64 * self.film.height as u64).max(1);

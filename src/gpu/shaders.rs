@@ -28,6 +28,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
     ("film.wgsl", include_str!("../../shaders/film.wgsl")),
     ("adaptive.wgsl", include_str!("../../shaders/adaptive.wgsl")),
+    ("aov.wgsl", include_str!("../../shaders/aov.wgsl")),
     ("integrator.wgsl", include_str!("../../shaders/integrator.wgsl")),
     ("trace.wgsl", include_str!("../../shaders/trace.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),

@@ -16,11 +16,14 @@ pub struct Features {
     pub sheen: bool,
     pub anisotropy: bool,
     pub iridescence: bool,
+    /// The render accumulates AOVs (a setting, not a property of the scene: false here, set
+    /// by the engine).
+    pub aovs: bool,
 }
 
 impl Features {
     /// The pipeline constants of `shaders/common.wgsl`.
-    pub fn constants(&self) -> [(&'static str, f64); 9] {
+    pub fn constants(&self) -> [(&'static str, f64); 10] {
         let f = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("ALPHA_TEST", f(self.alpha_test)),
@@ -32,6 +35,7 @@ impl Features {
             ("SHEEN", f(self.sheen)),
             ("ANISOTROPY", f(self.anisotropy)),
             ("IRIDESCENCE", f(self.iridescence)),
+            ("AOVS", f(self.aovs)),
         ]
     }
 }
@@ -69,6 +73,7 @@ impl PackedScene {
             sheen: self.materials.iter().any(|m| m.sheen_color.iter().any(|&c| c > 0.0)),
             anisotropy: self.materials.iter().any(|m| m.anisotropy > 0.0),
             iridescence: self.materials.iter().any(|m| m.iridescence > 0.0),
+            aovs: false,
         }
     }
 }

@@ -21,12 +21,15 @@ pub struct Cli {
 #[derive(Subcommand)]
 pub enum Command {
     /// Render a glTF 2.0 scene (.gltf/.glb) to a PNG (tone-mapped) or EXR (linear).
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Open the interactive preview window (egui), refining progressively on the GPU.
     #[cfg(feature = "viewer")]
     View(ViewArgs),
     /// Merge renders of disjoint sample ranges or tiles (EXRs written by veach) into one image.
     Merge(MergeArgs),
+    /// Denoise an EXR (R, G, B and, when present, its albedo and normal layers, as
+    /// `veach render --aov albedo,normal` writes them) with Open Image Denoise's network.
+    Denoise(DenoiseArgs),
     /// Render the seed's four direct-lighting estimators at equal spp, side by side with labels.
     Strategies(StrategiesArgs),
     /// Plot RMSE against render time (log-log) for renders made with --reference and
@@ -102,6 +105,38 @@ pub struct MergeArgs {
     pub output: PathBuf,
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_finite)]
     pub exposure: f32,
+}
+
+#[derive(clap::Args)]
+pub struct DenoiseArgs {
+    /// The noisy image: an EXR with R, G, B and optionally albedo.R/G/B and normal.X/Y/Z.
+    pub input: PathBuf,
+    /// The result: .png (the denoised image, tone-mapped) or .exr (the input's channels with
+    /// a `denoised` layer added: R, G, B stay the noisy image, and a veach render stays
+    /// resumable and mergeable).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// fast (the small network, half the work) or balanced (the base network).
+    #[arg(long, value_name = "Q", default_value = "balanced", value_parser = parse_quality)]
+    pub denoise_quality: veach::denoise::Quality,
+    /// Where the network runs: auto (the GPU on a hardware adapter, else the CPU), gpu or cpu.
+    #[arg(long, value_enum, default_value_t = Backend::Auto)]
+    pub backend: Backend,
+    /// The scale that brings the colour to the network's units (1 = 100 cd/m²; default:
+    /// measured from the image, as Open Image Denoise does).
+    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
+    pub input_scale: Option<f32>,
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_finite)]
+    pub exposure: f32,
+    #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
+    pub tonemap: Tonemap,
+    /// Write denoise statistics (time, engine, network) as JSON.
+    #[arg(long)]
+    pub stats_json: Option<PathBuf>,
+}
+
+pub fn parse_quality(s: &str) -> Result<veach::denoise::Quality, String> {
+    s.parse()
 }
 
 #[derive(clap::Args)]
@@ -293,6 +328,19 @@ pub struct RenderArgs {
     /// Continue the render saved in this checkpoint (or any EXR veach wrote) to its target.
     #[arg(long)]
     pub resume: Option<PathBuf>,
+    /// AOV layers to write with an EXR, comma-separated: albedo (albedo.R/G/B), normal
+    /// (normal.X/Y/Z, world space) and depth (depth.Z) of the first visible surface, looking
+    /// through mirrors and smooth glass, with the image's own samples.
+    #[arg(long, value_enum, value_delimiter = ',', conflicts_with = "resume")]
+    pub aov: Vec<veach::aov::Aov>,
+    /// Denoise the result with Open Image Denoise's network (run by veach, no driver needed):
+    /// the PNG is denoised; an EXR keeps the noisy image and its albedo and normal layers and
+    /// adds a `denoised` layer. Turns on the albedo and normal AOVs.
+    #[arg(long)]
+    pub denoise: bool,
+    /// fast (the small network) or balanced (the base network).
+    #[arg(long, value_name = "Q", default_value = "balanced", value_parser = parse_quality)]
+    pub denoise_quality: veach::denoise::Quality,
     /// Write render statistics as JSON.
     #[arg(long)]
     pub stats_json: Option<PathBuf>,

@@ -3,6 +3,7 @@
 mod args;
 #[cfg(feature = "bench")]
 mod bench;
+mod denoise;
 mod info;
 mod label;
 mod merge;
@@ -54,6 +55,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         args::Command::Render(a) => render::run(&a),
         args::Command::Merge(a) => done(merge::run(&a)),
+        args::Command::Denoise(a) => done(denoise::run(&a)),
         #[cfg(feature = "viewer")]
         args::Command::View(a) => done(view::run(a)),
         args::Command::Strategies(a) => done(strategies::run(&a)),

@@ -41,8 +41,15 @@ fn job_of(args: &RenderArgs) -> Result<(Job, Option<veach::Film>), Error> {
         clamp_indirect: args.clamp_indirect,
         noise_threshold: args.noise_threshold,
         min_samples: args.min_samples,
+        aovs: args.aov.clone(),
         ..Settings::default()
     };
+    // The denoiser reads the albedo and the normal.
+    if args.denoise {
+        settings.aovs.extend([veach::aov::Aov::Albedo, veach::aov::Aov::Normal]);
+    }
+    settings.aovs.sort();
+    settings.aovs.dedup();
     args.look.apply(&mut settings);
     settings.validate()?;
     let scene = std::fs::canonicalize(&scene).unwrap_or(scene);
@@ -156,7 +163,16 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     let film = renderer.film()?;
     let seconds_render = progress.seconds;
     bar.finish_and_clear();
-    veach::output::write_with(&film, &args.output, args.exposure, args.tonemap, Some(&job))?;
+    let mut denoise_seconds = None;
+    if args.denoise {
+        let options = veach::denoise::Options { quality: args.denoise_quality, ..Default::default() };
+        let start = Instant::now();
+        let denoised = veach::denoise::denoise_film(&film, &options)?;
+        denoise_seconds = Some(start.elapsed().as_secs_f64());
+        veach::output::write_denoised(&film, &denoised, &args.output, args.exposure, args.tonemap, Some(&job))?;
+    } else {
+        veach::output::write_with(&film, &args.output, args.exposure, args.tonemap, Some(&job))?;
+    }
     if let Some(path) = &args.checkpoint {
         veach::output::write(&film, path, 0.0, Some(&job))?;
     }
@@ -198,7 +214,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     }
     if let Some(path) = &args.stats_json {
         let s = &job.settings;
-        let stats = serde_json::json!({
+        let mut stats = serde_json::json!({
             "scene": job.scene.display().to_string(),
             "width": s.width,
             "height": s.height,
@@ -240,6 +256,16 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             "reference": args.reference.as_ref().map(|p| p.display().to_string()),
             "convergence": convergence,
         });
+        // (A second object: serde_json's macro has a recursion limit.)
+        let denoise = serde_json::json!({
+            "aovs": s.aovs,
+            "denoise_quality": args.denoise.then(|| args.denoise_quality.name()),
+            "denoise_engine": args.denoise.then_some("cpu"),
+            "denoise_seconds": denoise_seconds,
+        });
+        if let (Some(all), serde_json::Value::Object(more)) = (stats.as_object_mut(), denoise) {
+            all.extend(more);
+        }
         veach::output::write_atomic(path, serde_json::to_string_pretty(&stats).unwrap_or_default().as_bytes())?;
     }
     Ok(if interrupted { Outcome::Interrupted } else { Outcome::Done })
