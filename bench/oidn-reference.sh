@@ -7,6 +7,8 @@
 #   bench/oidn-reference.sh reference IN.exr... --out-dir DIR
 #       DIR/STEM.CASE.exr for the cases in bench/oidn_reference.py (balanced, fast, albedo,
 #       color, scale05), from EXRs written by `veach render --aov albedo,normal`
+#   bench/oidn-reference.sh strip IN.exr... --out-dir DIR
+#       DIR/STEM.input.exr: the colour, albedo and normal channels only (compact test inputs)
 #   bench/oidn-reference.sh bench --size 512x512 [--repeat 3] [--quality fast|balanced]
 #       OIDN's CPU time on a synthetic image of that size (after one warm-up run)
 # Environment:

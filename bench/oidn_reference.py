@@ -1,6 +1,8 @@
 """Denoise veach EXRs with the real Intel Open Image Denoise (PyPI pyoidn), for tests/denoise.rs
 and BENCHMARKS.md. Run through bench/oidn-reference.sh, which makes the venv.
 
+  strip IN.exr... --out-dir DIR       writes DIR/STEM.input.exr: only the colour, albedo and normal
+                                      channels of a veach EXR (compact test inputs)
   reference IN.exr... --out-dir DIR   writes DIR/STEM.CASE.exr for every case below
   bench --size WxH [--repeat N]       times OIDN's CPU device on a synthetic image
 
@@ -29,7 +31,7 @@ CASES = [
 
 def read_layers(path):
     with OpenEXR.File(path, separate_channels=True) as f:
-        ch = f.channels()
+        ch = {k: v for k, v in f.channels().items()}
         def rgb(names):
             return np.ascontiguousarray(np.stack([ch[n].pixels.astype(np.float32) for n in names], axis=-1))
         color = rgb(["R", "G", "B"])
@@ -70,6 +72,9 @@ def denoise(device, color, albedo, normal, quality, scale):
 def main():
     p = argparse.ArgumentParser()
     sub = p.add_subparsers(dest="cmd", required=True)
+    s = sub.add_parser("strip")
+    s.add_argument("inputs", nargs="+")
+    s.add_argument("--out-dir", required=True)
     r = sub.add_parser("reference")
     r.add_argument("inputs", nargs="+")
     r.add_argument("--out-dir", required=True)
@@ -78,13 +83,25 @@ def main():
     b.add_argument("--repeat", type=int, default=3)
     b.add_argument("--quality", default="balanced")
     a = p.parse_args()
+    if a.cmd == "strip":
+        os.makedirs(a.out_dir, exist_ok=True)
+        for path in a.inputs:
+            color, albedo, normal = read_layers(path)
+            channels = {c: np.ascontiguousarray(color[..., k]) for k, c in enumerate("RGB")}
+            channels.update({f"albedo.{c}": np.ascontiguousarray(albedo[..., k]) for k, c in enumerate("RGB")})
+            channels.update({f"normal.{c}": np.ascontiguousarray(normal[..., k]) for k, c in enumerate("XYZ")})
+            stem = os.path.splitext(os.path.basename(path))[0]
+            header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+            with OpenEXR.File(header, channels) as f:
+                f.write(os.path.join(a.out_dir, f"{stem}.input.exr"))
+        return
     with pyoidn.Device(pyoidn.OIDN_DEVICE_TYPE_CPU) as device:
         device.commit()
         if a.cmd == "reference":
             os.makedirs(a.out_dir, exist_ok=True)
             for path in a.inputs:
                 color, albedo, normal = read_layers(path)
-                stem = os.path.splitext(os.path.basename(path))[0]
+                stem = os.path.splitext(os.path.basename(path))[0].removesuffix(".input")
                 for name, quality, use_albedo, use_normal, scale in CASES:
                     out = denoise(device, color, albedo if use_albedo else None, normal if use_normal else None,
                                   quality, scale)

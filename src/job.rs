@@ -85,9 +85,11 @@ pub fn merge(parts: &[Part]) -> Result<(Film, Job), Error> {
     let Some(first) = parts.first() else {
         return Err(Error::Input("nothing to merge".into()));
     };
+    first.job.validate().map_err(|e| Error::Input(format!("{}: {e}", first.path.display())))?;
     let mut job = first.job.clone();
     let (w, h) = (job.settings.width, job.settings.height);
-    let mut merged = Film::new(w, h);
+    let layout = crate::film::FilmLayout { adaptive: false, aovs: !job.settings.aovs.is_empty() };
+    let mut merged = Film::with_layout(w, h, layout);
     let mut seen: Vec<(Tile, u32, u32, &Path)> = Vec::new();
     for part in parts {
         if part.job.settings.adaptive() {
