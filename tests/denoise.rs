@@ -226,7 +226,12 @@ fn denoising_brings_a_noisy_render_closer_to_the_reference() {
     };
     let noisy = rmse(&film.to_rgb32f());
     for quality in [Quality::Balanced, Quality::Fast] {
-        let denoised = veach::denoise::denoise_film(&film, &Options { quality, ..Default::default() }).unwrap();
+        let denoised = veach::denoise::denoise_film(
+            &film,
+            &Options { quality, ..Default::default() },
+            veach::denoise::Engine::Cpu,
+        )
+        .unwrap();
         let e = rmse(&denoised);
         eprintln!("{quality:?}: RMSE noisy {noisy:.4}, denoised {e:.4} ({:.1}x lower)", noisy / e);
         assert!(e * 1.7 < noisy, "{quality:?}: denoised {e} vs noisy {noisy}");
@@ -273,4 +278,50 @@ fn the_command_line_writes_aovs_and_denoises() {
         "best",
     );
     assert_user_error(&veach(&[&base[..], &["-o", s(&d.join("y.exr")), "--aov", "speed"]].concat(), &[]), "speed");
+}
+
+/// The WGSL network equals the Rust twin on the same inputs: the small and the base network,
+/// 9 and 3 input channels, a size that is not a multiple of 16, layers cut into bands of rows,
+/// and tiles. Tolerance: 1e-4 of |value| + 1e-4 (f32 sums in another order; measured below
+/// 2e-6 of |value| + 0.01 on lavapipe).
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn the_wgsl_network_matches_the_rust_twin() {
+    let Some(ctx) = common::gpu("the_wgsl_network_matches_the_rust_twin") else { return };
+    let (w, h) = (44, 30);
+    let (color, albedo, normal) = noise_image(w, h, 8);
+    for (quality, aux, bands) in
+        [(Quality::Fast, true, true), (Quality::Balanced, true, false), (Quality::Balanced, false, false)]
+    {
+        let images = Images {
+            width: w,
+            height: h,
+            color: &color,
+            albedo: aux.then_some(&albedo[..]),
+            normal: aux.then_some(&normal[..]),
+        };
+        let net = veach::denoise::network(quality, images.channels()).unwrap();
+        let mut gpu = veach::denoise::gpu::GpuDenoiser::new(&ctx, &net).unwrap();
+        if bands {
+            gpu.dispatch_macs = 2e6;
+        }
+        let options = Options { quality, input_scale: None, max_tile_pixels: None };
+        let ours = gpu.denoise(&images, &options).unwrap();
+        let twin = denoise_cpu(&images, &options).unwrap();
+        let rel = worst(&ours, &twin, 1e-2);
+        let e = ours.iter().zip(&twin).map(|(x, y)| (x - y).abs() / (1e-4 * y.abs() + 1e-4)).fold(0.0, f32::max);
+        eprintln!("{quality:?} aux {aux} bands {bands}: worst {rel:.2e}; {e:.3} of the tolerance");
+        assert!(e <= 1.0, "{quality:?} aux {aux}: {e} × the tolerance");
+    }
+    // In two tiles on the device, against the twin's whole image.
+    let (w, h) = (320, 32);
+    let (color, albedo, normal) = noise_image(w, h, 9);
+    let images = Images { width: w, height: h, color: &color, albedo: Some(&albedo), normal: Some(&normal) };
+    let whole = Options { quality: Quality::Fast, input_scale: Some(0.8), max_tile_pixels: None };
+    let tiled = Options { max_tile_pixels: Some(260 * 32), ..whole };
+    assert_eq!(plan_tiles(w, h, 260 * 32).len(), 2);
+    let ours = veach::denoise::denoise(&images, &tiled, veach::denoise::Engine::Gpu(&ctx)).unwrap();
+    let twin = denoise_cpu(&images, &whole).unwrap();
+    let e = ours.iter().zip(&twin).map(|(x, y)| (x - y).abs() / (1e-4 * y.abs() + 1e-4)).fold(0.0, f32::max);
+    assert!(e <= 1.0, "tiled on the GPU: {e} × the tolerance");
 }

@@ -19,6 +19,7 @@
 //! ```
 
 pub mod cpu;
+pub mod gpu;
 pub mod network;
 pub mod tiles;
 pub mod transfer;
@@ -103,14 +104,43 @@ pub fn denoise_cpu(images: &Images, options: &Options) -> Result<Vec<f32>, Error
     Ok(denoise_cpu_with(&net, images, options))
 }
 
-/// Denoises a film's mean (three floats a pixel, linear RGB) on the CPU, with its albedo and
-/// normal AOVs when it has them.
-pub fn denoise_film(film: &crate::Film, options: &Options) -> Result<Vec<f32>, Error> {
+/// Where the network runs.
+#[derive(Clone, Copy)]
+pub enum Engine<'a> {
+    /// The Rust twin.
+    Cpu,
+    /// The WGSL passes on this device.
+    Gpu(&'a crate::gpu::GpuContext),
+}
+
+impl Engine<'_> {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Engine::Cpu => "cpu",
+            Engine::Gpu(_) => "gpu",
+        }
+    }
+}
+
+/// Denoises `images` on `engine`.
+pub fn denoise(images: &Images, options: &Options, engine: Engine) -> Result<Vec<f32>, Error> {
+    images.validate().map_err(Error::Input)?;
+    let net = network(options.quality, images.channels())?;
+    match engine {
+        Engine::Cpu => Ok(denoise_cpu_with(&net, images, options)),
+        Engine::Gpu(ctx) => gpu::GpuDenoiser::new(ctx, &net)?.denoise(images, options),
+    }
+}
+
+/// Denoises a film's mean (three floats a pixel, linear RGB), with its albedo and normal AOVs
+/// when it has them.
+pub fn denoise_film(film: &crate::Film, options: &Options, engine: Engine) -> Result<Vec<f32>, Error> {
     let color = film.to_rgb32f();
     let albedo = film.aov_image(crate::aov::Aov::Albedo);
     let normal = film.aov_image(crate::aov::Aov::Normal);
     let (width, height) = (film.width as usize, film.height as usize);
-    denoise_cpu(&Images { width, height, color: &color, albedo: albedo.as_deref(), normal: normal.as_deref() }, options)
+    let images = Images { width, height, color: &color, albedo: albedo.as_deref(), normal: normal.as_deref() };
+    denoise(&images, options, engine)
 }
 
 /// Denoises on the CPU with a given network (its input channels match the images').

@@ -21,31 +21,45 @@ pub struct Tile {
 }
 
 /// Tiles covering a `width`×`height` image, each tensor at most `max_pixels` pixels where
-/// possible (a tile is never smaller than 16 + 2·overlap a side): one tile when the padded
-/// image fits, else bands of full rows when a band fits, else squares.
+/// possible: the grid of the fewest tensor pixels in all (overlaps count) among those whose
+/// tiles fit; when none fits, the finest grid (tiles of 16 + 2·overlap a side at most).
 pub fn plan_tiles(width: usize, height: usize, max_pixels: usize) -> Vec<Tile> {
     let (pw, ph) = (width.next_multiple_of(ALIGNMENT), height.next_multiple_of(ALIGNMENT));
-    let ov = TILE_OVERLAP;
-    let interior_for = |side: usize| (side.saturating_sub(2 * ov) / ALIGNMENT * ALIGNMENT).max(ALIGNMENT);
-    let (sx, sy) = if pw.saturating_mul(ph) <= max_pixels {
-        (pw, ph)
-    } else if pw.saturating_mul(ALIGNMENT + 2 * ov) <= max_pixels {
-        (pw, interior_for(max_pixels / pw))
-    } else {
-        let s = interior_for((max_pixels as f64).sqrt() as usize);
-        (s, s)
-    };
-    let spans = |size: usize, padded: usize, step: usize| -> Vec<(usize, usize, usize, usize)> {
+    // Tensor spans along one axis cut into `n` interiors: (origin, size, interior origin, size).
+    let spans = |size: usize, padded: usize, n: usize| -> Vec<(usize, usize, usize, usize)> {
+        let step = size.div_ceil(n).next_multiple_of(ALIGNMENT);
         (0..size.div_ceil(step))
             .map(|i| {
                 let (a, b) = (i * step, ((i + 1) * step).min(size));
-                let t0 = a.saturating_sub(ov);
-                let t1 = (b + ov).min(padded).next_multiple_of(ALIGNMENT);
+                let t0 = a.saturating_sub(TILE_OVERLAP);
+                let t1 = (b + TILE_OVERLAP).min(padded).next_multiple_of(ALIGNMENT);
                 (t0, t1 - t0, a, b - a)
             })
             .collect()
     };
-    let (xs, ys) = (spans(width, pw, sx), spans(height, ph, sy));
+    let largest = |v: &[(usize, usize, usize, usize)]| v.iter().map(|s| s.1).max().unwrap_or(0);
+    let total = |v: &[(usize, usize, usize, usize)]| v.iter().map(|s| s.1).sum::<usize>();
+    let (most_x, most_y) = (width.div_ceil(ALIGNMENT), height.div_ceil(ALIGNMENT));
+    let mut best: Option<(usize, Vec<_>, Vec<_>)> = None;
+    // Grids up to 64 tiles a side are tried (more only when they must be).
+    for nx in 1..=most_x.min(64) {
+        let xs = spans(width, pw, nx);
+        for ny in 1..=most_y.min(64) {
+            let ys = spans(height, ph, ny);
+            if largest(&xs) * largest(&ys) > max_pixels {
+                continue;
+            }
+            let cost = total(&xs) * total(&ys);
+            if best.as_ref().is_none_or(|b| cost < b.0) {
+                best = Some((cost, xs.clone(), ys));
+            }
+            break;
+        }
+    }
+    let (xs, ys) = match best {
+        Some((_, xs, ys)) => (xs, ys),
+        None => (spans(width, pw, most_x), spans(height, ph, most_y)),
+    };
     let mut tiles = Vec::with_capacity(xs.len() * ys.len());
     for &(ty, th, iy, ih) in &ys {
         for &(tx, tw, ix, iw) in &xs {
@@ -80,10 +94,13 @@ mod tests {
                 if tiles.len() > 1 {
                     assert!(t.width * t.height <= max.max((16 + 2 * TILE_OVERLAP).pow(2)), "{t:?} over {max}");
                 }
+                assert!(t.x + t.width <= w.next_multiple_of(16) && t.y + t.height <= h.next_multiple_of(16));
             }
             assert!(hits.iter().all(|&n| n == 1), "{w}x{h}: every pixel written once");
         }
         assert_eq!(plan_tiles(20, 12, 1 << 20).len(), 1);
         assert!(plan_tiles(240, 224, 224 * 224).len() > 1);
+        // Two tiles where two suffice.
+        assert_eq!(plan_tiles(320, 32, 260 * 32).len(), 2);
     }
 }

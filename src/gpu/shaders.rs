@@ -33,6 +33,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("trace.wgsl", include_str!("../../shaders/trace.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
     ("display.wgsl", include_str!("../../shaders/display.wgsl")),
+    ("denoise.wgsl", include_str!("../../shaders/denoise.wgsl")),
 ];
 
 /// The kernels' entry files.
@@ -40,6 +41,8 @@ pub const INTEGRATOR: &str = "integrator.wgsl";
 /// The ray-throughput kernel of `veach bench` (entry point `trace_rays`).
 pub const TRACE: &str = "trace.wgsl";
 pub const DISPLAY: &str = "display.wgsl";
+/// The denoiser's convolution layer (src/denoise/gpu.rs).
+pub const DENOISE: &str = "denoise.wgsl";
 
 /// Where the kernel reads scene geometry from: `#include "geometry.wgsl"` resolves to one of
 /// two files with the same load_* functions.

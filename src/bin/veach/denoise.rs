@@ -3,8 +3,27 @@
 
 use crate::args::DenoiseArgs;
 use std::time::Instant;
+use veach::Backend;
 use veach::Error;
-use veach::denoise::{Images, Options};
+use veach::denoise::{Engine, Images, Options};
+use veach::gpu::GpuContext;
+
+/// The device the network runs on (None: the CPU twin), and why: `auto` takes a hardware GPU
+/// and otherwise the CPU, whose twin outruns a software adapter's kernel.
+fn device(backend: Backend) -> Result<(Option<GpuContext>, String), Error> {
+    match backend {
+        Backend::Cpu => Ok((None, "requested".into())),
+        Backend::Gpu => Ok((Some(GpuContext::new()?), "requested".into())),
+        Backend::Auto => match veach::gpu::adapter_info() {
+            Ok(info) if info.device_type != wgpu::DeviceType::Cpu => {
+                Ok((Some(GpuContext::new()?), format!("auto: hardware GPU adapter ({})", info.name)))
+            }
+            Ok(info) => Ok((None, format!("auto: the only GPU adapter ({}) is a software one", info.name))),
+            Err(Error::NoAdapter(_)) => Ok((None, "auto: no GPU adapter".into())),
+            Err(e) => Err(e),
+        },
+    }
+}
 use veach::output::Format;
 
 pub fn run(args: &DenoiseArgs) -> Result<(), Error> {
@@ -18,8 +37,10 @@ pub fn run(args: &DenoiseArgs) -> Result<(), Error> {
         normal: layers.normal.as_deref(),
     };
     let options = Options { quality: args.denoise_quality, input_scale: args.input_scale, max_tile_pixels: None };
+    let (ctx, reason) = device(args.backend)?;
+    let engine = ctx.as_ref().map_or(Engine::Cpu, Engine::Gpu);
     let start = Instant::now();
-    let out = veach::denoise::denoise_cpu(&images, &options).map_err(|e| match e {
+    let out = veach::denoise::denoise(&images, &options, engine).map_err(|e| match e {
         Error::Input(m) => Error::Input(format!("{}: {m}", args.input.display())),
         e => e,
     })?;
@@ -36,8 +57,9 @@ pub fn run(args: &DenoiseArgs) -> Result<(), Error> {
         Format::Exr => veach::exr_layers::write_with_layer(&args.input, &args.output, "denoised", &out)?,
     }
     let (network, _) = veach::denoise::weight_file(args.denoise_quality, images.channels());
+    let on = ctx.as_ref().map_or("the CPU".to_string(), |c| c.info.name.clone());
     eprintln!(
-        "veach: denoised {} ({}x{}, {}) on the CPU in {seconds:.2} s",
+        "veach: denoised {} ({}x{}, {}) on {on} in {seconds:.2} s",
         args.input.display(),
         layers.width,
         layers.height,
@@ -49,7 +71,8 @@ pub fn run(args: &DenoiseArgs) -> Result<(), Error> {
             "height": layers.height,
             "network": network,
             "quality": args.denoise_quality.name(),
-            "denoise_engine": "cpu",
+            "denoise_engine": engine.name(),
+            "denoise_engine_reason": reason,
             "denoise_seconds": seconds,
             "inputs": images.channels(),
         });

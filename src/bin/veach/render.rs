@@ -164,10 +164,17 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     let seconds_render = progress.seconds;
     bar.finish_and_clear();
     let mut denoise_seconds = None;
+    let mut denoise_engine = "";
     if args.denoise {
         let options = veach::denoise::Options { quality: args.denoise_quality, ..Default::default() };
         let start = Instant::now();
-        let denoised = veach::denoise::denoise_film(&film, &options)?;
+        // The network runs where the render did.
+        let engine = match renderer.gpu() {
+            Some(g) => veach::denoise::Engine::Gpu(g.context()),
+            None => veach::denoise::Engine::Cpu,
+        };
+        denoise_engine = engine.name();
+        let denoised = veach::denoise::denoise_film(&film, &options, engine)?;
         denoise_seconds = Some(start.elapsed().as_secs_f64());
         veach::output::write_denoised(&film, &denoised, &args.output, args.exposure, args.tonemap, Some(&job))?;
     } else {
@@ -260,7 +267,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
         let denoise = serde_json::json!({
             "aovs": s.aovs,
             "denoise_quality": args.denoise.then(|| args.denoise_quality.name()),
-            "denoise_engine": args.denoise.then_some("cpu"),
+            "denoise_engine": args.denoise.then_some(denoise_engine),
             "denoise_seconds": denoise_seconds,
         });
         if let (Some(all), serde_json::Value::Object(more)) = (stats.as_object_mut(), denoise) {
