@@ -106,6 +106,16 @@ impl Film {
         Film { width, height, data: vec![0; layout.words(n)], layout }
     }
 
+    /// A film of one sample a pixel holding `rgb` (three floats a pixel, row-major): an image
+    /// made elsewhere (a denoised one) as the display pass reads films.
+    pub fn from_rgb(width: u32, height: u32, rgb: &[f32]) -> Film {
+        let mut film = Film::new(width, height);
+        for (i, c) in rgb.chunks_exact(3).enumerate().take(film.pixel_count()) {
+            film.add_sample(i, Vec3::new(c[0], c[1], c[2]));
+        }
+        film
+    }
+
     /// Bytes of a `width`×`height` film.
     pub fn bytes(width: u32, height: u32, layout: FilmLayout) -> u64 {
         layout.words(width as usize * height as usize) as u64 * 4

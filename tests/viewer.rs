@@ -25,6 +25,29 @@ fn viewer_screenshot_shows_the_render_and_the_panel() {
     let img = screenshot("auto", &["--heat-map"]);
     let green = img.pixels().filter(|p| p.0[1] > 40 && p.0[1] as u32 > 2 * p.0[0] as u32 + 2 * p.0[2] as u32).count();
     assert!(green < 50, "{green} green-wall pixels in the heat map");
+    // The denoiser: the same frames, the image far smoother (the screenshot waits for its
+    // first result), the walls still where they were.
+    let noisy = screenshot("auto", &[]);
+    let clean = screenshot("auto", &["--denoise"]);
+    let (a, b) = (roughness(&noisy), roughness(&clean));
+    assert!(b < 0.6 * a, "denoised roughness {b:.2} vs noisy {a:.2}");
+    screenshot_shows_the_render_and_the_panel_in(&clean, "auto --denoise");
+}
+
+/// Mean absolute difference of horizontally adjacent pixels in the image area (right of the
+/// panel): noise raises it; edges count alike with and without denoising.
+fn roughness(img: &image::RgbImage) -> f64 {
+    let (w, h) = img.dimensions();
+    let mut sum = 0u64;
+    let mut n = 0u64;
+    for y in h / 8..h - h / 8 {
+        for x in 320..w - 20 {
+            let (p, q) = (img.get_pixel(x, y).0, img.get_pixel(x + 1, y).0);
+            sum += (0..3).map(|c| (p[c] as i32 - q[c] as i32).unsigned_abs() as u64).sum::<u64>();
+            n += 1;
+        }
+    }
+    sum as f64 / n as f64
 }
 
 fn screenshot(backend: &str, extra: &[&str]) -> image::RgbImage {
@@ -46,7 +69,10 @@ fn screenshot(backend: &str, extra: &[&str]) -> image::RgbImage {
 }
 
 fn screenshot_shows_the_render_and_the_panel(backend: &str) {
-    let img = screenshot(backend, &[]);
+    screenshot_shows_the_render_and_the_panel_in(&screenshot(backend, &[]), backend);
+}
+
+fn screenshot_shows_the_render_and_the_panel_in(img: &image::RgbImage, backend: &str) {
     assert!(img.width() >= 600 && img.height() >= 380, "{}x{}", img.width(), img.height());
     // Red-wall and green-wall pixels in the image area (right of the panel), red left of green.
     let (mut red, mut green) = (Vec::new(), Vec::new());

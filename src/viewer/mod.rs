@@ -49,6 +49,8 @@ pub struct ViewOptions {
     pub noise_threshold: Option<f32>,
     /// Show the samples each pixel took (a heat map) from the start.
     pub heat_map: bool,
+    /// Start with the denoiser on.
+    pub denoise: bool,
 }
 
 /// The viewer's default noise threshold: between Cycles' viewport (0.1) and final (0.01)
@@ -125,6 +127,31 @@ struct Viewer {
     frame: u32,
     shot: Arc<Mutex<Option<Arc<egui::ColorImage>>>>,
     shot_requested: bool,
+    /// The denoiser (a panel toggle): runs on a worker thread whenever the image is still.
+    denoise: Denoise,
+}
+
+/// The viewer's denoiser state.
+struct Denoise {
+    on: bool,
+    quality: crate::denoise::Quality,
+    /// The denoise in progress on a worker thread.
+    job: Option<std::sync::mpsc::Receiver<Result<Denoised, Error>>>,
+    /// The latest result, shown while the camera is still.
+    result: Option<Denoised>,
+    /// Bumped by every restart: results of an older accumulation are dropped.
+    generation: u64,
+    /// Samples at which the next denoise starts (doubling: denoising costs about log2 of
+    /// the samples' number of runs).
+    next_at: u32,
+}
+
+/// A denoised image, as a film of one sample a pixel for the display pass.
+struct Denoised {
+    film: crate::Film,
+    samples: u32,
+    generation: u64,
+    seconds: f64,
 }
 
 impl Viewer {
@@ -187,8 +214,19 @@ impl Viewer {
             frame: 0,
             shot: Arc::new(Mutex::new(None)),
             shot_requested: false,
+            denoise: Denoise {
+                on: options.denoise,
+                quality: crate::denoise::Quality::Fast,
+                job: None,
+                result: None,
+                generation: 0,
+                next_at: 1,
+            },
             options,
         };
+        if v.denoise.on {
+            v.settings.aovs = DENOISER_AOVS.to_vec();
+        }
         if let Some(p) = v.options.scene.clone() {
             v.open_path = p.display().to_string();
             v.open(&p);
@@ -304,6 +342,69 @@ impl Viewer {
         self.converged = None;
         self.row = 0;
         self.dirty = false;
+        self.denoise.generation += 1;
+        self.denoise.next_at = 1;
+    }
+
+    /// Collects a finished denoise, and starts one when the image is still and has gained
+    /// samples since the last (at 1, 2, 4, ... spp, and when rendering stops).
+    fn step_denoiser(&mut self) {
+        let Some(r) = &self.renderer else { return };
+        let d = &mut self.denoise;
+        if let Some(rx) = &d.job {
+            match rx.try_recv() {
+                Ok(Ok(result)) => {
+                    d.job = None;
+                    if result.generation == d.generation {
+                        d.result = Some(result);
+                    }
+                }
+                Ok(Err(e)) => {
+                    d.job = None;
+                    self.error = Some(e.to_string());
+                }
+                Err(std::sync::mpsc::TryRecvError::Empty) => {}
+                Err(std::sync::mpsc::TryRecvError::Disconnected) => d.job = None,
+            }
+        }
+        let stopped = self.paused || self.samples >= self.target_spp || self.converged.is_some_and(|c| c >= 1.0);
+        let done = d.result.as_ref().filter(|x| x.generation == d.generation).map_or(0, |x| x.samples);
+        let due = self.samples >= d.next_at || (stopped && done < self.samples);
+        if !d.on || self.moving || d.job.is_some() || self.samples == 0 || done >= self.samples || !due {
+            return;
+        }
+        let film = match r.film() {
+            Ok(f) => f,
+            Err(e) => {
+                self.error = Some(e.to_string());
+                return;
+            }
+        };
+        let options = crate::denoise::Options { quality: d.quality, ..Default::default() };
+        // On the GPU engine the network runs on its device, else on the CPU twin.
+        let ctx = r.gpu().map(|g| g.context().clone());
+        let (generation, samples) = (d.generation, self.samples);
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let start = Instant::now();
+            let engine = ctx.as_ref().map_or(crate::denoise::Engine::Cpu, crate::denoise::Engine::Gpu);
+            let result = crate::denoise::denoise_film(&film, &options, engine).map(|rgb| Denoised {
+                film: crate::Film::from_rgb(film.width, film.height, &rgb),
+                samples,
+                generation,
+                seconds: start.elapsed().as_secs_f64(),
+            });
+            let _ = tx.send(result);
+        });
+        d.job = Some(rx);
+        d.next_at = self.samples.saturating_mul(2);
+    }
+
+    /// The denoised image to show instead of the film (the camera is still and it is of this
+    /// accumulation).
+    fn denoised(&self) -> Option<&crate::Film> {
+        let d = &self.denoise;
+        d.result.as_ref().filter(|x| d.on && !self.moving && x.generation == d.generation).map(|x| &x.film)
     }
 
     fn save(&mut self, png: bool) {
@@ -383,12 +484,18 @@ impl eframe::App for Viewer {
                     self.rate = pixels as f64 / t.elapsed().as_secs_f64().max(1e-6);
                 }
             }
-            if let Some(r) = &self.renderer
-                && let Some(film) = film_on_device(r, &self.rs, &mut self.uploaded_film)
-            {
+            self.step_denoiser();
+            let showing_denoised = self.denoised().is_some();
+            let shown = if showing_denoised {
+                let film = self.denoise.result.as_ref().map(|d| &d.film);
+                film.and_then(|f| upload_film(f, &self.rs, &mut self.uploaded_film))
+            } else {
+                self.renderer.as_ref().and_then(|r| film_on_device(r, &self.rs, &mut self.uploaded_film))
+            };
+            if let Some(film) = shown {
                 let (w, h) = (self.settings.width, self.settings.height);
                 let Some(display) = &mut self.display else { return };
-                let heat = if self.heat_map { self.samples.max(1) } else { 0 };
+                let heat = if self.heat_map && !showing_denoised { self.samples.max(1) } else { 0 };
                 let look = crate::gpu::Look { exposure: self.exposure, tonemap: self.tonemap, heat_max: heat };
                 let (view, new) = display.resolve(&self.rs.device, &self.rs.queue, &film, (w, h), look);
                 let mut egui_renderer = self.rs.renderer.write();
@@ -418,7 +525,9 @@ impl eframe::App for Viewer {
             }
         });
         if let Some(out) = self.options.screenshot.clone() {
-            if self.frame >= self.options.frames && !self.shot_requested {
+            // With the denoiser on, the screenshot waits for its first result.
+            let ready = !self.denoise.on || self.denoised().is_some();
+            if self.frame >= self.options.frames && ready && !self.shot_requested {
                 let slot = self.shot.clone();
                 let ctx = ui.ctx().clone();
                 ui.ctx().request_screenshot(move |img| {
@@ -458,6 +567,9 @@ fn viewer_backend(asked: crate::Backend, adapter: &wgpu::AdapterInfo) -> (crate:
     }
 }
 
+/// The AOVs the denoiser reads.
+const DENOISER_AOVS: [crate::aov::Aov; 2] = [crate::aov::Aov::Albedo, crate::aov::Aov::Normal];
+
 /// The film as a buffer of the window's device: the GPU engine's own, or the CPU engine's
 /// uploaded into `upload` (same layout, 12 words a pixel; a few MB a frame).
 fn film_on_device(
@@ -468,7 +580,15 @@ fn film_on_device(
     if let Some(g) = r.gpu() {
         return Some(g.film_buffer().clone());
     }
-    let film = r.film().ok()?;
+    upload_film(&r.film().ok()?, rs, upload)
+}
+
+/// A host film uploaded into `upload`, a buffer of the window's device.
+fn upload_film(
+    film: &crate::Film,
+    rs: &egui_wgpu::RenderState,
+    upload: &mut Option<wgpu::Buffer>,
+) -> Option<wgpu::Buffer> {
     let bytes: &[u8] = bytemuck::cast_slice(&film.data);
     if upload.as_ref().is_none_or(|b| b.size() != bytes.len() as u64) {
         *upload = Some(rs.device.create_buffer(&wgpu::BufferDescriptor {

@@ -41,6 +41,34 @@ impl Viewer {
         }
         self.settings.noise_threshold = adaptive.then_some(threshold);
         ui.checkbox(&mut self.heat_map, "show samples per pixel").on_hover_text("a heat map: dark few, bright many");
+        let hint = "Open Image Denoise's network, run by veach, whenever the image is still: at 1, 2, 4, ... \
+                    samples and when rendering stops";
+        if ui.checkbox(&mut self.denoise.on, "denoise").on_hover_text(hint).changed() {
+            // The denoiser reads the albedo and normal AOVs: the film gains or loses them.
+            self.settings.aovs = if self.denoise.on { super::DENOISER_AOVS.to_vec() } else { Vec::new() };
+            changed = true;
+        }
+        if self.denoise.on {
+            let before = self.denoise.quality;
+            egui::ComboBox::from_label("denoise quality").selected_text(self.denoise.quality.name()).show_ui(
+                ui,
+                |ui| {
+                    for q in [crate::denoise::Quality::Fast, crate::denoise::Quality::Balanced] {
+                        ui.selectable_value(&mut self.denoise.quality, q, q.name());
+                    }
+                },
+            );
+            if before != self.denoise.quality {
+                self.denoise.result = None;
+                self.denoise.next_at = 1;
+            }
+            let text = match (&self.denoise.result, &self.denoise.job) {
+                (_, Some(_)) => "denoising…".to_string(),
+                (Some(d), None) => format!("denoised at {} spp in {:.2} s", d.samples, d.seconds),
+                (None, None) => "denoised: not yet".to_string(),
+            };
+            ui.label(text);
+        }
         let before = (self.settings.strategy, self.settings.light_sampler, self.settings.max_depth, self.env_strength);
         egui::ComboBox::from_label("strategy").selected_text(format!("{:?}", self.settings.strategy)).show_ui(
             ui,

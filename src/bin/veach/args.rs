@@ -79,6 +79,10 @@ pub struct ViewArgs {
     /// Start showing the samples each pixel took (a heat map) instead of the image.
     #[arg(long)]
     pub heat_map: bool,
+    /// Start with the denoiser on (a panel toggle): the image is denoised whenever it is
+    /// still, on a worker thread.
+    #[arg(long)]
+    pub denoise: bool,
 }
 
 /// The smallest window side the viewer lays out its panel in.

@@ -20,6 +20,7 @@ pub fn run(args: ViewArgs) -> Result<(), Error> {
         render_scale: args.render_scale,
         backend: args.backend,
         heat_map: args.heat_map,
+        denoise: args.denoise,
         noise_threshold: (args.noise_threshold > 0.0).then_some(args.noise_threshold),
     })
 }
