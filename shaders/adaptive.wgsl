@@ -5,7 +5,6 @@
 #include "bindings.wgsl"
 #include "film.wgsl"
 
-const ADAPTIVE_WORDS: u32 = 4u;
 
 fn film_pixels() -> u32 {
     return params.film_width * params.film_height;

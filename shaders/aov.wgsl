@@ -6,7 +6,6 @@
 #include "bindings.wgsl"
 #include "film.wgsl"
 
-const AOV_ROWS: u32 = 4u;
 
 struct AovSample {
     albedo: vec3<f32>,

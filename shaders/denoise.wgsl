@@ -103,8 +103,9 @@ fn conv3x3(@builtin(global_invocation_id) gid: vec3<u32>) {
             break;
         }
         if (p.pool == 1u) {
-            let m = max(max(acc[k], acc[DENOISE_BLOCKS + k]), max(acc[2u * DENOISE_BLOCKS + k], acc[3u * DENOISE_BLOCKS + k]));
-            dst[((y0 / 2u) * (p.width / 2u) + x0 / 2u) * p.out_blocks + ob] = max(m, vec4<f32>(0.0));
+            let top = max(acc[k], acc[DENOISE_BLOCKS + k]);
+            let bottom = max(acc[2u * DENOISE_BLOCKS + k], acc[3u * DENOISE_BLOCKS + k]);
+            dst[((y0 / 2u) * (p.width / 2u) + x0 / 2u) * p.out_blocks + ob] = max(max(top, bottom), vec4<f32>(0.0));
         } else {
             for (var q = 0u; q < 4u; q++) {
                 let x = x0 + (q & 1u);

@@ -1,6 +1,7 @@
 // The viewer's resolve pass: film mean × 2^exposure → tone map → sRGB, into the texture
 // egui shows (no readback to the CPU). The film layout is film.wgsl's.
 #include "tonemap.wgsl"
+#include "film_layout.wgsl"
 
 struct DisplayParams {
     width: u32,
@@ -36,7 +37,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= display.width || gid.y >= display.height) {
         return;
     }
-    let base = 3u * (gid.y * display.width + gid.x);
+    let base = FILM_WORDS * (gid.y * display.width + gid.x);
     let hi = film[base];
     let lo = film[base + 1u];
     var mean = vec3<f32>(0.0);

@@ -1,9 +1,7 @@
 // Accumulation into the film: 64-bit fixed-point sums (two u32 words), so that films of
 // sample ranges and tiles merge exactly. Twin: src/film.rs (layout and arithmetic there).
 #include "bindings.wgsl"
-
-const FILM_WORDS: u32 = 3u; // vec4<u32> rows per pixel
-const MAX_SAMPLE: f32 = 2147483520.0;
+#include "film_layout.wgsl"
 
 // Where invocation `gid` of a dispatch writes: its film slot and its image pixel (the film
 // covers the tile, from row params.row_offset on); `inside` is false past the film's edge.

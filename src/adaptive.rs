@@ -19,12 +19,7 @@ use crate::film::{Film, film_sum};
 use crate::params::Params;
 use glam::Vec3;
 
-/// Samples between two convergence tests.
-pub const ADAPTIVE_STEP: u32 = 8;
-
-/// Samples every pixel takes before its first test (a multiple of the step): fewer, and the
-/// two half estimates of a dark pixel can agree by chance.
-pub const DEFAULT_MIN_SAMPLES: u32 = 16;
+pub use crate::settings::{ADAPTIVE_STEP, DEFAULT_MIN_SAMPLES};
 
 /// Whether pixels that have taken `n` samples are tested now. Twin of `adaptive_test_due`.
 pub fn adaptive_test_due(params: &Params, n: u32) -> bool {

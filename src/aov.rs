@@ -18,7 +18,7 @@
 //! (normal + 1) hi x, y, z, surfaces hit, (normal + 1) lo x, y, z, 0]`. The normal is stored
 //! biased by 1 so its sums stay non-negative.
 
-use crate::film::to_fixed;
+use crate::film::{Film, to_fixed};
 use glam::Vec3;
 
 /// What one sample saw of the first visible surface.
@@ -36,30 +36,7 @@ impl Default for AovSample {
     }
 }
 
-/// Which AOV layers a render writes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "lowercase")]
-pub enum Aov {
-    /// `albedo.R/G/B`: the first visible surface's albedo, in [0, 1].
-    Albedo,
-    /// `normal.X/Y/Z`: its shading normal in world space, in [−1, 1].
-    Normal,
-    /// `depth.Z`: its distance from the camera (infinite where nothing was hit).
-    Depth,
-}
-
-impl Aov {
-    pub const ALL: [Aov; 3] = [Aov::Albedo, Aov::Normal, Aov::Depth];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Aov::Albedo => "albedo",
-            Aov::Normal => "normal",
-            Aov::Depth => "depth",
-        }
-    }
-}
+pub use crate::settings::Aov;
 
 /// Adds `v` (finite, ≥ 0) to the fixed-point sum whose high word is `hi` and low word `lo`.
 #[inline]
@@ -83,15 +60,8 @@ pub fn aov_add_sample(record: &mut [u32], a: &AovSample) {
     }
 }
 
-/// Adds the record `src` to `dst`, exactly (merging films).
-pub fn aov_merge(dst: &mut [u32], src: &[u32]) {
-    for (hi, lo) in [(0, 4), (1, 5), (2, 6), (3, 7), (8, 12), (9, 13), (10, 14)] {
-        let (sum, carry) = dst[lo].overflowing_add(src[lo]);
-        dst[lo] = sum;
-        dst[hi] = dst[hi].wrapping_add(src[hi]).wrapping_add(carry as u32);
-    }
-    dst[11] = dst[11].wrapping_add(src[11]);
-}
+/// The (high, low) word pairs of the record's fixed-point sums; word 11 is a count.
+pub const AOV_FIXED_PAIRS: [(usize, usize); 7] = [(0, 4), (1, 5), (2, 6), (3, 7), (8, 12), (9, 13), (10, 14)];
 
 fn sum(record: &[u32], hi: usize, lo: usize) -> f64 {
     record[hi] as f64 + record[lo] as f64 * (1.0 / 4294967296.0)
@@ -116,4 +86,19 @@ pub fn aov_normal(record: &[u32], samples: u32) -> Vec3 {
 /// The mean camera distance of the samples that hit a surface (infinite when none did).
 pub fn aov_depth(record: &[u32]) -> f32 {
     if record[11] == 0 { f32::INFINITY } else { (sum(record, 3, 7) / record[11] as f64) as f32 }
+}
+
+impl Film {
+    /// An AOV image (row-major): three floats a pixel for the albedo and the normal, one for
+    /// the depth; None when the film has no AOVs.
+    pub fn aov_image(&self, aov: Aov) -> Option<Vec<f32>> {
+        self.has_aovs().then(|| {
+            let pixels = 0..self.pixel_count();
+            match aov {
+                Aov::Albedo => pixels.flat_map(|i| aov_albedo(self.aov_words(i), self.taken(i)).to_array()).collect(),
+                Aov::Normal => pixels.flat_map(|i| aov_normal(self.aov_words(i), self.taken(i)).to_array()).collect(),
+                Aov::Depth => pixels.map(|i| aov_depth(self.aov_words(i))).collect(),
+            }
+        })
+    }
 }

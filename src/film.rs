@@ -41,11 +41,6 @@ pub struct FilmLayout {
 }
 
 impl FilmLayout {
-    /// The layout a render with these parameters accumulates into.
-    pub fn of(params: &crate::params::Params) -> FilmLayout {
-        FilmLayout { adaptive: params.noise_threshold > 0.0, aovs: params.aov_base > 0 }
-    }
-
     /// Words of the regions before the AOVs (pixels, then adaptive sampling's).
     pub fn aov_base(self, pixels: usize) -> usize {
         pixels * WORDS_PER_PIXEL + if self.adaptive { pixels * ADAPTIVE_WORDS + pixels.next_multiple_of(4) } else { 0 }
@@ -230,20 +225,6 @@ impl Film {
         (0..self.pixel_count()).flat_map(|i| self.mean(i).to_array()).collect()
     }
 
-    /// An AOV image (row-major): three floats a pixel for the albedo and the normal, one for
-    /// the depth; None when the film has no AOVs.
-    pub fn aov_image(&self, aov: crate::aov::Aov) -> Option<Vec<f32>> {
-        use crate::aov::{Aov, aov_albedo, aov_depth, aov_normal};
-        self.has_aovs().then(|| {
-            let pixels = 0..self.pixel_count();
-            match aov {
-                Aov::Albedo => pixels.flat_map(|i| aov_albedo(self.aov_words(i), self.taken(i)).to_array()).collect(),
-                Aov::Normal => pixels.flat_map(|i| aov_normal(self.aov_words(i), self.taken(i)).to_array()).collect(),
-                Aov::Depth => pixels.map(|i| aov_depth(self.aov_words(i))).collect(),
-            }
-        })
-    }
-
     /// The variance of each pixel's mean, per channel (row-major, three floats a pixel).
     pub fn variance(&self) -> Vec<f32> {
         (0..self.pixel_count()).flat_map(|i| self.variance_of_mean(i).to_array()).collect()
@@ -274,7 +255,7 @@ impl Film {
         if self.layout != other.layout {
             return Err("a film with AOVs does not merge with one without".into());
         }
-        let tile = crate::Tile { x, y, width: other.width, height: other.height };
+        let tile = crate::tile::Tile { x, y, width: other.width, height: other.height };
         if !tile.fits(self.width, self.height) || other.data.len() != other.layout.words(other.pixel_count()) {
             return Err(format!(
                 "a {}x{} film at {x},{y} does not fit in the {}x{} image",
@@ -297,7 +278,14 @@ impl Film {
                 if self.layout.aovs {
                     let src = other.aov_words((oy * other.width + ox) as usize).to_vec();
                     let at = self.aov_record(i);
-                    crate::aov::aov_merge(&mut self.data[at..at + AOV_WORDS], &src);
+                    let dst = &mut self.data[at..at + AOV_WORDS];
+                    // Seven fixed-point sums (high, low words) and a count (src/aov.rs).
+                    for (hi, lo) in [(0, 4), (1, 5), (2, 6), (3, 7), (8, 12), (9, 13), (10, 14)] {
+                        let (sum, carry) = dst[lo].overflowing_add(src[lo]);
+                        dst[lo] = sum;
+                        dst[hi] = dst[hi].wrapping_add(src[hi]).wrapping_add(carry as u32);
+                    }
+                    dst[11] = dst[11].wrapping_add(src[11]);
                 }
             }
         }

@@ -115,12 +115,64 @@ pub fn merge(parts: &[Part]) -> Result<(Film, Job), Error> {
                 )));
             }
         }
+        for (t, _, _, other) in &seen {
+            if t.overlaps(&window) && *t != window {
+                return Err(Error::Input(format!(
+                    "{}: its tile overlaps that of {} without being the same tile",
+                    part.path.display(),
+                    other.display()
+                )));
+            }
+        }
         seen.push((window, start, end, &part.path));
         merged
             .merge_at(&part.film, window.x, window.y)
             .map_err(|e| Error::Input(format!("{}: {e}", part.path.display())))?;
-        job.sample_start = job.sample_start.min(start);
-        job.sample_end = job.sample_end.max(end);
+    }
+    // Every tile's samples must make one range, the same for all tiles: a resumed render
+    // continues after the range its job records, so a gap (0..2 and 4..6 recorded as 0..6)
+    // would take samples 4 and 5 twice.
+    let mut range: Option<(u32, u32)> = None;
+    let mut tiles: Vec<Tile> = Vec::new();
+    for s in &seen {
+        if !tiles.contains(&s.0) {
+            tiles.push(s.0);
+        }
+    }
+    for tile in tiles {
+        let mut ranges: Vec<(u32, u32, &Path)> = seen.iter().filter(|s| s.0 == tile).map(|s| (s.1, s.2, s.3)).collect();
+        ranges.sort_unstable_by_key(|r| r.0);
+        for pair in ranges.windows(2) {
+            if pair[0].1 != pair[1].0 {
+                return Err(Error::Input(format!(
+                    "{}: samples {}..{} leave a gap after {}'s {}..{}; merge the missing range too",
+                    pair[1].2.display(),
+                    pair[1].0,
+                    pair[1].1,
+                    pair[0].2.display(),
+                    pair[0].0,
+                    pair[0].1
+                )));
+            }
+        }
+        let (first, last) = (ranges[0], ranges[ranges.len() - 1]);
+        match range {
+            None => range = Some((first.0, last.1)),
+            Some(r) if r != (first.0, last.1) => {
+                return Err(Error::Input(format!(
+                    "{}: its tile has samples {}..{}, another tile {}..{}: every tile must have the same samples",
+                    last.2.display(),
+                    first.0,
+                    last.1,
+                    r.0,
+                    r.1
+                )));
+            }
+            Some(_) => {}
+        }
+    }
+    if let Some((start, end)) = range {
+        (job.sample_start, job.sample_end) = (start, end);
     }
     // The merged film covers the whole image.
     job.settings.tile = None;

@@ -23,6 +23,7 @@
 
 #[doc(hidden)]
 pub mod accel;
+#[doc(hidden)]
 pub mod adaptive;
 pub mod aov;
 #[cfg(feature = "bench")]
@@ -48,6 +49,7 @@ pub mod scene;
 mod settings;
 #[doc(hidden)]
 pub mod sheen;
+mod tile;
 pub mod tonemap;
 #[cfg(feature = "viewer")]
 pub mod viewer;
@@ -61,5 +63,6 @@ pub use render_loop::{Budget, CHUNK_SECONDS, Control, MAX_CHUNK, Progress, rende
 pub use renderer::{ROW_BAND, Renderer};
 pub use scene::{Camera, Environment, EnvironmentMap, Scene};
 pub use settings::{
-    Backend, EnvironmentSource, LightSampler, MAX_FILM_BYTES, MAX_IMAGE_SIDE, SamplerKind, Settings, Strategy, Tile,
+    Backend, EnvironmentSource, LightSampler, MAX_FILM_BYTES, MAX_IMAGE_SIDE, SamplerKind, Settings, Strategy,
 };
+pub use tile::Tile;

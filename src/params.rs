@@ -91,6 +91,11 @@ pub fn env_select_probability(environment: Vec3, has_map: bool, map_total: f32, 
 }
 
 impl Params {
+    /// The film a render with these parameters accumulates into.
+    pub fn film_layout(&self) -> crate::film::FilmLayout {
+        crate::film::FilmLayout { adaptive: self.noise_threshold > 0.0, aovs: self.aov_base > 0 }
+    }
+
     /// The parameters of `settings` for `camera` over the window `tile`, before the lens is
     /// set up (a pinhole).
     pub fn new(camera: &Camera, settings: &Settings, tile: Tile, scene: &PackedScene) -> Params {
@@ -139,7 +144,7 @@ impl Params {
             clamp_indirect: settings.clamp_indirect.unwrap_or(f32::MAX),
             noise_threshold: settings.noise_threshold.unwrap_or(0.0),
             adaptive_min_samples: settings.adaptive_min_samples(),
-            adaptive_step: crate::adaptive::ADAPTIVE_STEP,
+            adaptive_step: crate::settings::ADAPTIVE_STEP,
             sheen_base: scene.sheen_base,
             aov_base: if settings.aovs.is_empty() {
                 0

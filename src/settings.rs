@@ -128,27 +128,37 @@ impl EnvironmentSource {
     }
 }
 
-/// A crop window of the image (the whole image by default).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub struct Tile {
-    pub x: u32,
-    pub y: u32,
-    pub width: u32,
-    pub height: u32,
+pub use crate::tile::Tile;
+
+/// Samples between two convergence tests of adaptive sampling (`src/adaptive.rs`).
+pub const ADAPTIVE_STEP: u32 = 8;
+
+/// Samples every pixel takes before its first test (a multiple of the step): fewer, and the
+/// two half estimates of a dark pixel can agree by chance.
+pub const DEFAULT_MIN_SAMPLES: u32 = 16;
+
+/// Which AOV layers a render writes (`src/aov.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "lowercase")]
+pub enum Aov {
+    /// `albedo.R/G/B`: the first visible surface's albedo, in [0, 1].
+    Albedo,
+    /// `normal.X/Y/Z`: its shading normal in world space, in [−1, 1].
+    Normal,
+    /// `depth.Z`: its distance from the camera (infinite where nothing was hit).
+    Depth,
 }
 
-impl Tile {
-    /// Whether the tile is non-empty and lies inside a `width`×`height` image (no overflow).
-    pub fn fits(&self, width: u32, height: u32) -> bool {
-        let inside = |o: u32, n: u32, side: u32| n > 0 && o.checked_add(n).is_some_and(|end| end <= side);
-        inside(self.x, self.width, width) && inside(self.y, self.height, height)
-    }
+impl Aov {
+    pub const ALL: [Aov; 3] = [Aov::Albedo, Aov::Normal, Aov::Depth];
 
-    pub fn overlaps(&self, o: &Tile) -> bool {
-        let span = |a: u32, n: u32| a as u64..a as u64 + n as u64;
-        let (ax, ay, bx, by) =
-            (span(self.x, self.width), span(self.y, self.height), span(o.x, o.width), span(o.y, o.height));
-        ax.start < bx.end && bx.start < ax.end && ay.start < by.end && by.start < ay.end
+    pub fn name(self) -> &'static str {
+        match self {
+            Aov::Albedo => "albedo",
+            Aov::Normal => "normal",
+            Aov::Depth => "depth",
+        }
     }
 }
 
@@ -210,7 +220,7 @@ pub struct Settings {
     /// AOV layers written with the image (`src/aov.rs`); the film accumulates all three as
     /// soon as one is asked for. Empty: none (the film has no AOV region).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub aovs: Vec<crate::aov::Aov>,
+    pub aovs: Vec<Aov>,
 }
 
 impl Default for Settings {
@@ -256,10 +266,10 @@ impl Settings {
     }
 
     /// Samples each pixel takes before its first convergence test: as set, else
-    /// `adaptive::DEFAULT_MIN_SAMPLES`; rounded up to a whole number of test steps.
+    /// `DEFAULT_MIN_SAMPLES`; rounded up to a whole number of test steps.
     pub fn adaptive_min_samples(&self) -> u32 {
-        let step = crate::adaptive::ADAPTIVE_STEP;
-        self.min_samples.unwrap_or(crate::adaptive::DEFAULT_MIN_SAMPLES).clamp(step, 1 << 20).next_multiple_of(step)
+        let step = ADAPTIVE_STEP;
+        self.min_samples.unwrap_or(DEFAULT_MIN_SAMPLES).clamp(step, 1 << 20).next_multiple_of(step)
     }
 
     /// The window rendered: the tile, or the whole image.

@@ -134,6 +134,51 @@ fn parts_of_other_renders_are_refused() {
     // Overlapping samples in the same pixels are refused too.
     let c = part(d.path(), "c.exr", &["--sample-range", "1..3"]);
     assert_user_error(&veach(&["merge", s(&a), s(&c), "-o", s(&out)], &[]), "overlap");
+    // A gap in the samples: merged as 0..6, a resume would take samples 4 and 5 twice.
+    let gap = part(d.path(), "gap.exr", &["--sample-range", "4..6"]);
+    assert_user_error(&veach(&["merge", s(&a), s(&gap), "-o", s(&out)], &[]), "gap");
+    // Tiles whose samples differ, and tiles that half overlap.
+    let left = part(d.path(), "left.exr", &["--sample-range", "0..2", "--tile", "0,0,8,16"]);
+    let right = part(d.path(), "right.exr", &["--sample-range", "0..4", "--tile", "8,0,8,16"]);
+    assert_user_error(&veach(&["merge", s(&left), s(&right), "-o", s(&out)], &[]), "same samples");
+    let shifted = part(d.path(), "shifted.exr", &["--sample-range", "2..4", "--tile", "4,0,8,16"]);
+    assert_user_error(&veach(&["merge", s(&left), s(&shifted), "-o", s(&out)], &[]), "same tile");
+    // Tiles by sample ranges, in any order, merge into the whole render.
+    let right2 = part(d.path(), "right2.exr", &["--sample-range", "2..4", "--tile", "8,0,8,16"]);
+    let left2 = part(d.path(), "left2.exr", &["--sample-range", "2..4", "--tile", "0,0,8,16"]);
+    let right3 = part(d.path(), "right3.exr", &["--sample-range", "0..2", "--tile", "8,0,8,16"]);
+    ok(veach(&["merge", s(&right2), s(&left), s(&right3), s(&left2), "-o", s(&out)], &[]));
+    let (film, job) = veach::output::read_film(&out).unwrap();
+    assert_eq!((film.samples(), job.sample_start, job.sample_end), (4, 0, 4));
+    let whole = part(d.path(), "whole.exr", &["--spp", "4"]);
+    let (reference, _) = veach::output::read_film(&whole).unwrap();
+    let exact = |f: &veach::Film| -> Vec<u32> {
+        (0..f.pixel_count()).flat_map(|i| f.data[i * 12..i * 12 + 8].to_vec()).collect()
+    };
+    assert!(exact(&film) == exact(&reference), "tiles x ranges = the whole render");
+}
+
+/// A damaged EXR's job may name any path as its scene: a device or a pipe is refused, never
+/// read forever.
+#[test]
+#[cfg(unix)]
+fn a_resumed_job_naming_a_device_is_refused() {
+    let d = temp_dir("hostile-scene");
+    let base = std::fs::read(part(d.path(), "base.exr", &["--spp", "2"])).unwrap();
+    let (_, _, mut job) = metadata(&base);
+    let fifo = d.path().join("fifo");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success());
+    let mut devices = vec!["/dev/zero".to_string()];
+    if made {
+        devices.push(fifo.display().to_string());
+    }
+    for device in devices {
+        *job.pointer_mut("/job/scene").unwrap() = Value::from(device.clone());
+        let bad = d.path().join("bad.exr");
+        std::fs::write(&bad, with_metadata(&base, &job)).unwrap();
+        let out = d.path().join("out.exr");
+        assert_user_error(&veach(&["render", "--resume", s(&bad), "-o", s(&out)], &[]), "not a regular file");
+    }
 }
 
 #[test]
@@ -170,9 +215,19 @@ fn hostile_flags_exit_2() {
         assert_user_error(&o, needle);
     }
     let saved = part(d.path(), "saved.exr", &["--spp", "2"]);
-    for flags in
-        [&["--spp", "8"][..], &["--width", "32"], &["--env-color", "1,1,1"], &["--tile", "0,0,4,4"], &["--seed", "2"]]
-    {
+    // Flags at their default values too: a saved render made with other values would
+    // silently ignore them.
+    for flags in [
+        &["--spp", "8"][..],
+        &["--width", "32"],
+        &["--env-color", "1,1,1"],
+        &["--tile", "0,0,4,4"],
+        &["--seed", "2"],
+        &["--light-sampler", "tree"],
+        &["--env-strength", "1"],
+        &["--aperture", "0"],
+        &["--aov", "depth"],
+    ] {
         let mut args = vec!["render", "--resume", s(&saved), "-o", s(&out)];
         args.extend_from_slice(flags);
         let o = veach(&args, &[]);

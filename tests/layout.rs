@@ -6,6 +6,7 @@
 use bytemuck::Zeroable;
 use std::collections::HashMap;
 use veach::accel::{BvhNode, CwNode, Instance};
+use veach::denoise::gpu::ConvParams;
 use veach::gpu::shaders::{self, Geometry, SOURCES};
 use veach::packed::{Attributes, LightEntry, Material, Punctual, TextureRef, Triangle};
 use veach::params::Params;
@@ -72,7 +73,11 @@ const SLOT_RECORDS: &[&str] = &["CwNode", "Instance"];
 
 #[test]
 fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
-    let modules = [module(shaders::INTEGRATOR, Geometry::Buffers), module(shaders::INTEGRATOR, Geometry::Textures)];
+    let modules = [
+        module(shaders::INTEGRATOR, Geometry::Buffers),
+        module(shaders::INTEGRATOR, Geometry::Textures),
+        module(shaders::DENOISE, Geometry::Buffers),
+    ];
     let wgsl = wgsl_structs(&modules);
     let rust: Vec<(&str, Layout)> = vec![
         (
@@ -177,6 +182,10 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
         ("Instance", rust_layout!(Instance { object_to_world, world_to_object, blas_root, flags, pad })),
         ("BvhNode", rust_layout!(BvhNode { min, index, max, count })),
         ("CwNode", rust_layout!(CwNode { p, e_imask, child_base, primitive_base, child_meta, qx, qy, qz, pad })),
+        (
+            "ConvParams",
+            rust_layout!(ConvParams { width, height, a_blocks, b_blocks, out_blocks, a_half, pool, quad_row_offset }),
+        ),
     ];
     let mut wrong = Vec::new();
     for (name, (rust_size, fields)) in &rust {
@@ -278,6 +287,9 @@ fn shared_constants_have_the_same_values() {
         ("TONEMAP_NEUTRAL", veach::tonemap::Tonemap::Neutral as u32 as f64),
         ("FILM_WORDS", (veach::film::WORDS_PER_PIXEL / 4) as f64),
         ("ADAPTIVE_WORDS", veach::film::ADAPTIVE_WORDS as f64),
+        ("AOV_ROWS", (veach::film::AOV_WORDS / 4) as f64),
+        ("TLAS_STACK_SIZE", veach::cpu::bvh::TLAS_STACK_SIZE as f64),
+        ("DENOISE_BLOCKS", veach::denoise::gpu::DENOISE_BLOCKS as f64),
         ("MAX_SAMPLE", veach::film::MAX_SAMPLE as f64),
         ("PAGE_ROW_LOG2", veach::gpu::PAGE_ROW_LOG2 as f64),
         ("NO_HIT", veach::cpu::bvh::NO_HIT as f64),

@@ -8,7 +8,7 @@ use glam::{IVec3, UVec2, UVec3, Vec3, Vec3A, Vec4};
 pub const NO_HIT: u32 = u32::MAX;
 // One group per tree level: accel refuses deeper mesh BVHs.
 const STACK_SIZE: usize = crate::accel::MAX_DEPTH as usize;
-const TLAS_STACK_SIZE: usize = 64;
+pub const TLAS_STACK_SIZE: usize = 64;
 pub const INF: f32 = 3.4e38;
 
 #[derive(Clone, Copy, Debug)]

@@ -17,7 +17,7 @@ pub struct Renderer {
 }
 
 fn empty_film(params: &Params) -> Film {
-    Film::with_layout(params.film_width, params.film_height, crate::film::FilmLayout::of(params))
+    Film::with_layout(params.film_width, params.film_height, params.film_layout())
 }
 
 /// One film row's regions: its pixels' words, and when the film has them, adaptive

@@ -15,7 +15,7 @@ use crate::gpu::GpuContext;
 use wgpu::util::DeviceExt;
 
 /// Output channel blocks one invocation computes (`DENOISE_BLOCKS` in the shader).
-const DENOISE_BLOCKS: u32 = 2;
+pub const DENOISE_BLOCKS: u32 = 2;
 /// Quads per workgroup side (`@workgroup_size(8, 8)`).
 const GROUP: u32 = 8;
 /// The most multiply-adds one dispatch does: ~1 ms on a discrete GPU, ~1 s on lavapipe.

@@ -8,14 +8,17 @@ mod display;
 mod film;
 mod geometry;
 mod renderer;
+#[doc(hidden)]
 pub mod shaders;
 mod textures;
 #[cfg(feature = "bench")]
 mod trace;
 
+#[doc(hidden)]
 pub use bindings::TABLE as BINDINGS;
 pub use context::{GeometryPlacement, GpuContext, GpuOptions, NO_ADAPTER_HINT, adapter_info, adapters};
 pub use display::{Display, Look};
+#[doc(hidden)]
 pub use renderer::{GpuRenderer, WORKGROUP_SIDE};
 
 use crate::Error;

@@ -6,7 +6,7 @@ use super::film::DeviceFilm;
 use super::{GeometryPlacement, GpuContext, MAX_BATCH, shaders, storage_buffer};
 use crate::Error;
 use crate::adaptive::adaptive_test_due;
-use crate::film::{Film, FilmLayout};
+use crate::film::Film;
 use crate::packed::PackedScene;
 use crate::params::Params;
 
@@ -95,7 +95,7 @@ impl GpuRenderer {
         let features = crate::packed::Features { aovs: params.aov_base > 0, ..scene.features() };
         let constants = features.constants();
         let (pipeline, settle) = Self::pipelines(device, &pipeline_layout, &module, &constants);
-        let film = DeviceFilm::new(&ctx, params.film_width, params.film_height, FilmLayout::of(&params))?;
+        let film = DeviceFilm::new(&ctx, params.film_width, params.film_height, params.film_layout())?;
         let bind_group = bindings::bind_group(device, &layout, &resources, &params_buf, &film.buffer);
         let gpu_bytes = resources.buffer_bytes() + film.buffer.size() + params_buf.size() + texture_bytes + paged_bytes;
         ctx.check()?;
@@ -157,7 +157,7 @@ impl GpuRenderer {
                 self.trace_pipelines = [None, None, None];
             }
         }
-        self.film = DeviceFilm::new(&self.ctx, params.film_width, params.film_height, FilmLayout::of(&params))?;
+        self.film = DeviceFilm::new(&self.ctx, params.film_width, params.film_height, params.film_layout())?;
         self.bind_group =
             bindings::bind_group(&self.ctx.device, &self.layout, &self.scene, &self.params_buf, &self.film.buffer);
         Ok(())
@@ -177,7 +177,7 @@ impl GpuRenderer {
     /// New parameters (camera, settings, window) and an empty film: the viewer's restart.
     pub fn reset(&mut self, params: Params) -> Result<(), Error> {
         self.taken = 0;
-        if (params.film_width, params.film_height, FilmLayout::of(&params))
+        if (params.film_width, params.film_height, params.film_layout())
             != (self.film.width, self.film.height, self.film.layout)
         {
             self.new_film(params)?;

@@ -26,6 +26,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("spherical_triangle.wgsl", include_str!("../../shaders/spherical_triangle.wgsl")),
     ("light_tree.wgsl", include_str!("../../shaders/light_tree.wgsl")),
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
+    ("film_layout.wgsl", include_str!("../../shaders/film_layout.wgsl")),
     ("film.wgsl", include_str!("../../shaders/film.wgsl")),
     ("adaptive.wgsl", include_str!("../../shaders/adaptive.wgsl")),
     ("aov.wgsl", include_str!("../../shaders/aov.wgsl")),

@@ -5,8 +5,11 @@
 
 pub mod camera;
 pub mod environment;
+#[doc(hidden)]
 pub mod gltf;
+#[doc(hidden)]
 pub mod studio;
+#[doc(hidden)]
 pub mod tangents;
 
 pub use camera::Camera;

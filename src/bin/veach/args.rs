@@ -40,7 +40,7 @@ pub enum Command {
     /// each backend (samples/s), with load and BVH-build times, geometry bytes per triangle
     /// and BVH traversal throughput. See BENCHMARKS.md and bench/compare-mitsuba.sh.
     Bench(BenchArgs),
-    /// List the Vulkan adapters and their limits, or describe a scene.
+    /// List the GPU adapters (Vulkan, Metal, DX12) and their limits, or describe a scene.
     Info {
         /// A .gltf/.glb file: print its triangles, meshes, instances, materials, textures,
         /// lights, extensions and bounds.
@@ -235,19 +235,20 @@ pub struct LookArgs {
     /// Equirectangular environment map (.hdr or .exr), importance-sampled; --env-color tints it.
     #[arg(long)]
     pub env: Option<PathBuf>,
-    /// Scales the environment (map or color).
-    #[arg(long, default_value_t = 1.0, value_parser = parse_non_negative, allow_negative_numbers = true)]
-    pub env_strength: f32,
-    /// Thin-lens radius in scene units for depth of field (default: a pinhole).
-    #[arg(long, default_value_t = 0.0, value_parser = parse_non_negative, allow_negative_numbers = true)]
-    pub aperture: f32,
+    /// Scales the environment (map or color) [default: 1].
+    #[arg(long, value_parser = parse_non_negative, allow_negative_numbers = true)]
+    pub env_strength: Option<f32>,
+    /// Thin-lens radius in scene units for depth of field (default: 0, a pinhole).
+    #[arg(long, value_parser = parse_non_negative, allow_negative_numbers = true)]
+    pub aperture: Option<f32>,
     /// Distance in focus (default with --aperture: what the image centre sees).
     #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub focus_distance: Option<f32>,
     /// How next-event estimation picks a light: tree (the light BVH: by importance to the
-    /// shading point) or power (by power alone, the former sampler, kept for comparison).
-    #[arg(long, value_enum, default_value_t = LightSampler::Tree)]
-    pub light_sampler: LightSampler,
+    /// shading point; the default) or power (by power alone, the former sampler, kept for
+    /// comparison).
+    #[arg(long, value_enum)]
+    pub light_sampler: Option<LightSampler>,
 }
 
 #[derive(clap::Args)]
@@ -424,20 +425,22 @@ impl LookArgs {
         settings.camera = self.camera.clone();
         settings.env_map = self.env.as_deref().map(absolute);
         settings.env_color = self.env_color.map(Into::into);
-        settings.env_strength = self.env_strength;
-        settings.aperture = self.aperture;
+        let defaults = veach::Settings::default();
+        settings.env_strength = self.env_strength.unwrap_or(defaults.env_strength);
+        settings.aperture = self.aperture.unwrap_or(defaults.aperture);
         settings.focus_distance = self.focus_distance;
-        settings.light_sampler = self.light_sampler;
+        settings.light_sampler = self.light_sampler.unwrap_or(defaults.light_sampler);
     }
 
-    /// Whether any of these flags was given (they conflict with --resume).
+    /// Whether any of these flags was given, even at its default value (they conflict with
+    /// --resume, which continues the saved render as it was).
     pub fn any(&self) -> bool {
         self.camera.is_some()
             || self.env_color.is_some()
             || self.env.is_some()
-            || self.env_strength != 1.0
-            || self.aperture != 0.0
-            || self.light_sampler != LightSampler::Tree
+            || self.env_strength.is_some()
+            || self.aperture.is_some()
+            || self.light_sampler.is_some()
             || self.focus_distance.is_some()
     }
 }

@@ -38,10 +38,21 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
     if meta.is_dir() {
         return Err(fail("is a directory, not a glTF file".into()));
     }
+    // A device or a pipe (/dev/zero, a FIFO named by a damaged EXR's job) would be read
+    // forever or block: only regular files, and never more than the limit.
+    if !meta.is_file() {
+        return Err(fail("not a regular file".into()));
+    }
     if meta.len() > MAX_FILE_BYTES {
         return Err(fail(format!("{} bytes: larger than the {MAX_FILE_BYTES}-byte limit", meta.len())));
     }
-    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    let mut bytes = Vec::new();
+    let file = std::fs::File::open(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    std::io::Read::read_to_end(&mut std::io::Read::take(file, MAX_FILE_BYTES + 1), &mut bytes)
+        .map_err(|e| fail(format!("cannot read: {e}")))?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(fail(format!("larger than the {MAX_FILE_BYTES}-byte limit")));
+    }
     load_bytes(&bytes, path.parent()).map_err(fail)
 }
 
