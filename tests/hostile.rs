@@ -146,6 +146,9 @@ fn at<'a>(v: &'a mut Value, path: &[Value]) -> &'a mut Value {
     })
 }
 
+/// GPU time the mutation test spends rendering what loads (after the first six, always).
+const GPU_BUDGET_SECONDS: f64 = 45.0;
+
 #[test]
 fn mutated_assets_never_panic() {
     let mut rng = Lcg(12345);
@@ -157,6 +160,8 @@ fn mutated_assets_never_panic() {
     let hostile =
         [json!(-1), json!(0), json!(1), json!(3), json!(65535), json!(4294967295u64), json!(1e20), json!(0.5)];
     let (mut loaded, mut refused, mut inputs, mut gpu_runs) = (0, 0, 0, 0usize);
+    let mut gpu_seconds = 0.0;
+    let gpu_ctx = common::gpu("mutated_assets_never_panic");
     let start = std::time::Instant::now();
     for round in 0..3000 {
         let base = &originals[round % originals.len()];
@@ -200,10 +205,11 @@ fn mutated_assets_never_panic() {
             Ok(Ok(scene)) => {
                 loaded += 1;
                 // What loads renders without a panic and with no non-finite sample, on the CPU
-                // engine always and on the GPU for the first few (each GPU renderer compiles
-                // its pipeline).
-                let gpu_turn = gpu_runs < 6;
-                let nonfinite = std::panic::catch_unwind(|| {
+                // engine always and on the GPU as many as fit a time budget (each GPU renderer
+                // compiles its pipeline: about a second on lavapipe), at least six.
+                let gpu_turn = gpu_runs < 6 || gpu_seconds < GPU_BUDGET_SECONDS;
+                let gpu_start = std::time::Instant::now();
+                let nonfinite = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                     let camera = scene.camera(None).ok()?;
                     let packed = veach::PackedScene::new(&scene);
                     let s = veach::Settings {
@@ -214,17 +220,20 @@ fn mutated_assets_never_panic() {
                         ..Default::default()
                     };
                     let mut counts = Vec::new();
-                    let ctxs = [None, if gpu_turn { common::gpu("mutated_assets_never_panic") } else { None }];
+                    let ctxs = [None, if gpu_turn { gpu_ctx.clone() } else { None }];
                     for ctx in ctxs.into_iter().enumerate().filter(|(k, c)| *k == 0 || c.is_some()).map(|(_, c)| c) {
                         let mut r = common::renderer(packed.clone(), &camera, &s, ctx).ok()?;
                         r.render_samples(0, 2).ok()?;
                         counts.push(r.film().ok()?.nonfinite_samples());
                     }
                     Some(counts)
-                });
+                }));
                 match nonfinite {
                     Ok(Some(counts)) => {
                         gpu_runs += (counts.len() > 1) as usize;
+                        if counts.len() > 1 {
+                            gpu_seconds += gpu_start.elapsed().as_secs_f64();
+                        }
                         if counts.iter().any(|&c| c > 0) {
                             let _ = std::fs::write(std::env::temp_dir().join("veach-nonfinite-input.gltf"), &bytes);
                             panic!(
@@ -249,7 +258,10 @@ fn mutated_assets_never_panic() {
             }
         }
     }
-    eprintln!("{inputs} mutated inputs: {loaded} loaded, {refused} refused, {:.1} s", start.elapsed().as_secs_f64());
+    eprintln!(
+        "{inputs} mutated inputs: {loaded} loaded ({gpu_runs} also on the GPU), {refused} refused, {:.1} s",
+        start.elapsed().as_secs_f64()
+    );
     assert!(loaded > 100 && refused > 100, "the mutations exercise both outcomes");
 }
 

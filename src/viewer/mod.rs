@@ -58,10 +58,23 @@ pub struct ViewOptions {
 pub const NOISE_THRESHOLD: f32 = 0.05;
 
 pub fn run(options: ViewOptions) -> Result<(), Error> {
+    // The window's device asks for the adapter's own limits (eframe asks for WebGPU's
+    // defaults: a 128 MiB storage binding even on GPUs that offer GiBs), so scenes page their
+    // geometry only when this device needs it, as `veach render` does.
+    let mut setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
+    setup.device_descriptor = Arc::new(|adapter: &wgpu::Adapter| wgpu::DeviceDescriptor {
+        label: Some("veach viewer"),
+        required_limits: adapter.limits(),
+        ..Default::default()
+    });
     let native = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_inner_size([options.window.0 as f32, options.window.1 as f32])
             .with_title("veach"),
+        wgpu_options: egui_wgpu::WgpuConfiguration {
+            wgpu_setup: egui_wgpu::WgpuSetup::CreateNew(setup),
+            ..Default::default()
+        },
         ..Default::default()
     };
     let result: Arc<Mutex<Result<(), Error>>> = Arc::new(Mutex::new(Ok(())));

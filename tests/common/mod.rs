@@ -29,6 +29,11 @@ pub fn gpu(test: &str) -> Option<GpuContext> {
             if std::env::var("VEACH_REQUIRE_GPU").as_deref() == Ok("1") {
                 panic!("{test}: VEACH_REQUIRE_GPU=1 but the GPU is unavailable: {e}");
             }
+            // The build found a Vulkan driver: an adapter that does not open is a failure,
+            // never a quiet skip (without a driver the GPU tests are reported as ignored).
+            if cfg!(not(veach_no_gpu)) {
+                panic!("{test}: this machine has a Vulkan driver but no adapter opens: {e}");
+            }
             eprintln!("SKIPPED the GPU part of {test}: {e}");
             None
         }
