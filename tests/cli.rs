@@ -468,11 +468,10 @@ fn reference_records_convergence_and_plots_it() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-#[test]
-fn bench_reports_renders_and_ray_rates_per_backend() {
-    // A smoke test of the benchmark's report (its numbers are timings and are not judged here).
-    let with_gpu = common::gpu("bench_reports_renders_and_ray_rates_per_backend").is_some();
-    let d = temp_dir("bench");
+/// A smoke test of the benchmark's report (its numbers are timings and are not judged here),
+/// on the CPU and, `with_gpu`, on the GPU too.
+fn bench_report(with_gpu: bool) {
+    let d = temp_dir(if with_gpu { "bench-gpu" } else { "bench" });
     let json = d.join("bench.json");
     let mut args = vec![
         "bench",
@@ -524,6 +523,20 @@ fn bench_reports_renders_and_ray_rates_per_backend() {
             assert!(gpu[1].1 > 0.0 && gpu[1].1 <= gpu[0].1 && gpu[1].1 == gpu[2].1, "{gpu:?}");
         }
     }
+}
+
+#[test]
+fn bench_reports_renders_and_ray_rates_per_backend() {
+    bench_report(false);
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn bench_reports_renders_and_ray_rates_per_backend_on_the_gpu() {
+    if common::gpu("bench_reports_renders_and_ray_rates_per_backend_on_the_gpu").is_none() {
+        return;
+    }
+    bench_report(true);
 }
 
 /// `--noise-threshold`: the stats report the mean spp and the converged fraction, the EXR a

@@ -130,26 +130,35 @@ fn gpu_and_cpu_agree_under_a_sky() {
 
 /// A new sky through `Renderer::set_environment` (light data replaced, geometry and BVH
 /// kept) renders exactly what a renderer built with that sky renders, on both engines.
-#[test]
-fn a_new_sky_renders_as_a_renderer_built_with_it() {
+fn a_new_sky_renders_as_built_with_it(ctx: Option<veach::gpu::GpuContext>) {
     let (scene, camera) = common::load_pair(&asset("furnace-a080.gltf"), None).expect("scene");
     let new_sky = veach::Environment::map(sky(16, 8), Vec3::splat(0.7));
     let mut with_sky = scene.clone();
     with_sky.environment = new_sky.clone();
     let s = settings(24, 4, 3);
-    for ctx in [None, gpu("a_new_sky_renders_as_a_renderer_built_with_it")] {
-        let mut swapped = common::renderer(PackedScene::new(&scene), &camera, &s, ctx.clone()).unwrap();
-        swapped.render_samples(0, 2).unwrap();
-        // Compared as bytes: CWBVH nodes in BvhNode-sized slots can read as NaN floats.
-        let bytes = |r: &veach::Renderer| bytemuck::cast_slice::<_, u8>(&r.scene().nodes).to_vec();
-        let nodes = bytes(&swapped);
-        swapped.set_environment(&camera, &new_sky).unwrap();
-        swapped.render_samples(0, 4).unwrap();
-        let mut fresh = common::renderer(PackedScene::new(&with_sky), &camera, &s, ctx).unwrap();
-        fresh.render_samples(0, 4).unwrap();
-        assert!(swapped.film().unwrap().data == fresh.film().unwrap().data, "the swapped sky renders differently");
-        assert!(bytes(&swapped) == nodes, "the BVH changed");
-    }
+    let mut swapped = common::renderer(PackedScene::new(&scene), &camera, &s, ctx.clone()).unwrap();
+    swapped.render_samples(0, 2).unwrap();
+    // Compared as bytes: CWBVH nodes in BvhNode-sized slots can read as NaN floats.
+    let bytes = |r: &veach::Renderer| bytemuck::cast_slice::<_, u8>(&r.scene().nodes).to_vec();
+    let nodes = bytes(&swapped);
+    swapped.set_environment(&camera, &new_sky).unwrap();
+    swapped.render_samples(0, 4).unwrap();
+    let mut fresh = common::renderer(PackedScene::new(&with_sky), &camera, &s, ctx).unwrap();
+    fresh.render_samples(0, 4).unwrap();
+    assert!(swapped.film().unwrap().data == fresh.film().unwrap().data, "the swapped sky renders differently");
+    assert!(bytes(&swapped) == nodes, "the BVH changed");
+}
+
+#[test]
+fn a_new_sky_renders_as_a_renderer_built_with_it() {
+    a_new_sky_renders_as_built_with_it(None);
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn a_new_sky_renders_as_a_renderer_built_with_it_on_the_gpu() {
+    let Some(ctx) = gpu("a_new_sky_renders_as_a_renderer_built_with_it_on_the_gpu") else { return };
+    a_new_sky_renders_as_built_with_it(Some(ctx));
 }
 
 /// The stored default studio (`assets/studio.hdr`, what renders use) is its generator's
@@ -174,9 +183,9 @@ fn the_stored_studio_is_its_generator_s_output() {
 /// kind. By default the studio lights it, and it reads the studio's irradiance on +Z over π,
 /// which the generator sets to 1 (a check of the map's orientation and of its sampling end to
 /// end); `env_color` 0,0,0 keeps it black on purpose.
-#[test]
-fn a_scene_without_lights_is_lit_by_the_studio_unless_asked_for_black() {
-    let dir = std::env::temp_dir().join(format!("veach-studio-{}", std::process::id()));
+fn lit_by_the_studio_unless_asked_for_black(ctx: Option<veach::gpu::GpuContext>) {
+    let engine = if ctx.is_some() { "gpu" } else { "cpu" };
+    let dir = std::env::temp_dir().join(format!("veach-studio-{}-{engine}", std::process::id()));
     let mut b = common::build::GltfBuilder::new(&dir, "white-quad");
     b.use_extension("KHR_materials_specular");
     let white = b.material(serde_json::json!({
@@ -190,29 +199,36 @@ fn a_scene_without_lights_is_lit_by_the_studio_unless_asked_for_black() {
     let path = b.write();
     let (scene, camera) = common::load_pair(&path, None).expect("scene");
     let s = settings(16, 2, 1);
-    for ctx in [None, gpu("a_scene_without_lights_is_lit_by_the_studio_unless_asked_for_black")] {
-        let mut r = common::renderer(PackedScene::new(&scene), &camera, &s, ctx.clone()).unwrap();
-        assert_eq!(r.environment_source(), veach::EnvironmentSource::Studio);
-        r.render_samples(0, 256).unwrap();
-        let film = r.film().unwrap();
-        let n = film.pixel_count();
-        let mean = (0..n).map(|i| film.mean(i)).sum::<Vec3>() / n as f32;
-        assert!((mean - Vec3::ONE).abs().max_element() < 0.02, "the white quad reads {mean}, expected 1");
+    let mut r = common::renderer(PackedScene::new(&scene), &camera, &s, ctx.clone()).unwrap();
+    assert_eq!(r.environment_source(), veach::EnvironmentSource::Studio);
+    r.render_samples(0, 256).unwrap();
+    let film = r.film().unwrap();
+    let n = film.pixel_count();
+    let mean = (0..n).map(|i| film.mean(i)).sum::<Vec3>() / n as f32;
+    assert!((mean - Vec3::ONE).abs().max_element() < 0.02, "the white quad reads {mean}, expected 1");
 
-        let black = veach::Settings { env_color: Some([0.0; 3]), ..s.clone() };
-        let mut r = common::renderer(PackedScene::new(&scene), &camera, &black, ctx).unwrap();
-        assert_eq!(r.environment_source(), veach::EnvironmentSource::Settings);
-        r.render_samples(0, 4).unwrap();
-        assert!(r.film().unwrap().to_rgb32f().iter().all(|v| *v == 0.0), "asked for black");
-    }
-    // A scene with lights of its own keeps its (black) environment.
-    let r = common::renderer(
-        PackedScene::new(&common::load_pair(&asset("cornell-box.gltf"), None).unwrap().0),
-        &camera,
-        &s,
-        None,
-    )
-    .unwrap();
-    assert_eq!(r.environment_source(), veach::EnvironmentSource::Scene);
+    let black = veach::Settings { env_color: Some([0.0; 3]), ..s.clone() };
+    let mut r = common::renderer(PackedScene::new(&scene), &camera, &black, ctx).unwrap();
+    assert_eq!(r.environment_source(), veach::EnvironmentSource::Settings);
+    r.render_samples(0, 4).unwrap();
+    assert!(r.film().unwrap().to_rgb32f().iter().all(|v| *v == 0.0), "asked for black");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_scene_without_lights_is_lit_by_the_studio_unless_asked_for_black() {
+    lit_by_the_studio_unless_asked_for_black(None);
+    // A scene with lights of its own keeps its (black) environment.
+    let (scene, camera) = common::load_pair(&asset("cornell-box.gltf"), None).unwrap();
+    let r = common::renderer(PackedScene::new(&scene), &camera, &settings(16, 2, 1), None).unwrap();
+    assert_eq!(r.environment_source(), veach::EnvironmentSource::Scene);
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn a_scene_without_lights_is_lit_by_the_studio_unless_asked_for_black_on_the_gpu() {
+    let Some(ctx) = gpu("a_scene_without_lights_is_lit_by_the_studio_unless_asked_for_black_on_the_gpu") else {
+        return;
+    };
+    lit_by_the_studio_unless_asked_for_black(Some(ctx));
 }

@@ -149,8 +149,8 @@ fn at<'a>(v: &'a mut Value, path: &[Value]) -> &'a mut Value {
 /// GPU time the mutation test spends rendering what loads (after the first six, always).
 const GPU_BUDGET_SECONDS: f64 = 45.0;
 
-#[test]
-fn mutated_assets_never_panic() {
+/// The mutation test's inputs, the same sequence on every call: (round, bytes).
+fn mutated_inputs() -> impl Iterator<Item = (usize, Vec<u8>)> {
     let mut rng = Lcg(12345);
     let originals: Vec<Vec<u8>> = ["cornell-box.gltf", "veach-mis.gltf"]
         .iter()
@@ -159,11 +159,7 @@ fn mutated_assets_never_panic() {
         .collect();
     let hostile =
         [json!(-1), json!(0), json!(1), json!(3), json!(65535), json!(4294967295u64), json!(1e20), json!(0.5)];
-    let (mut loaded, mut refused, mut inputs, mut gpu_runs) = (0, 0, 0, 0usize);
-    let mut gpu_seconds = 0.0;
-    let gpu_ctx = common::gpu("mutated_assets_never_panic");
-    let start = std::time::Instant::now();
-    for round in 0..3000 {
+    (0..3000).map(move |round| {
         let base = &originals[round % originals.len()];
         let bytes = match round % 3 {
             // Structured: a few numbers (indices, counts, offsets, strides, types) made hostile.
@@ -199,54 +195,57 @@ fn mutated_assets_never_panic() {
                 b
             }
         };
+        (round, bytes)
+    })
+}
+
+/// Renders a loaded mutated input on one engine: its count of non-finite samples, or None
+/// when it has no camera or the engine refuses it (an error, not a panic).
+fn nonfinite_samples_of(scene: &veach::Scene, ctx: Option<veach::gpu::GpuContext>) -> Option<u64> {
+    let camera = scene.camera(None).ok()?;
+    let packed = veach::PackedScene::new(scene);
+    let s = veach::Settings { width: 8, height: 8, max_depth: 4, env_color: Some([0.5; 3]), ..Default::default() };
+    let mut r = common::renderer(packed, &camera, &s, ctx).ok()?;
+    r.render_samples(0, 2).ok()?;
+    Some(r.film().ok()?.nonfinite_samples())
+}
+
+/// Checks one mutated input's render on an engine: no panic, no non-finite sample. Whether
+/// it rendered at all.
+fn render_mutated(round: usize, bytes: &[u8], scene: &veach::Scene, ctx: Option<veach::gpu::GpuContext>) -> bool {
+    let engine = if ctx.is_some() { "gpu" } else { "cpu" };
+    let nonfinite = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| nonfinite_samples_of(scene, ctx)));
+    match nonfinite {
+        Ok(Some(count)) => {
+            if count > 0 {
+                let _ = std::fs::write(std::env::temp_dir().join("veach-nonfinite-input.gltf"), bytes);
+                panic!(
+                    "input {round} renders {count} non-finite samples on the {engine} (saved to veach-nonfinite-input.gltf)"
+                );
+            }
+            true
+        }
+        Ok(None) => false,
+        Err(_) => {
+            let _ = std::fs::write(std::env::temp_dir().join("veach-panic-input.gltf"), bytes);
+            panic!("input {round} panicked while rendering on the {engine} (saved to veach-panic-input.gltf)");
+        }
+    }
+}
+
+#[test]
+fn mutated_assets_never_panic() {
+    let (mut loaded, mut refused, mut inputs) = (0, 0, 0);
+    let start = std::time::Instant::now();
+    for (round, bytes) in mutated_inputs() {
         inputs += 1;
         let result = std::panic::catch_unwind(|| load_bytes(&bytes, None));
         match result {
             Ok(Ok(scene)) => {
                 loaded += 1;
-                // What loads renders without a panic and with no non-finite sample, on the CPU
-                // engine always and on the GPU as many as fit a time budget (each GPU renderer
-                // compiles its pipeline: about a second on lavapipe), at least six.
-                let gpu_turn = gpu_runs < 6 || gpu_seconds < GPU_BUDGET_SECONDS;
-                let gpu_start = std::time::Instant::now();
-                let nonfinite = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    let camera = scene.camera(None).ok()?;
-                    let packed = veach::PackedScene::new(&scene);
-                    let s = veach::Settings {
-                        width: 8,
-                        height: 8,
-                        max_depth: 4,
-                        env_color: Some([0.5; 3]),
-                        ..Default::default()
-                    };
-                    let mut counts = Vec::new();
-                    let ctxs = [None, if gpu_turn { gpu_ctx.clone() } else { None }];
-                    for ctx in ctxs.into_iter().enumerate().filter(|(k, c)| *k == 0 || c.is_some()).map(|(_, c)| c) {
-                        let mut r = common::renderer(packed.clone(), &camera, &s, ctx).ok()?;
-                        r.render_samples(0, 2).ok()?;
-                        counts.push(r.film().ok()?.nonfinite_samples());
-                    }
-                    Some(counts)
-                }));
-                match nonfinite {
-                    Ok(Some(counts)) => {
-                        gpu_runs += (counts.len() > 1) as usize;
-                        if counts.len() > 1 {
-                            gpu_seconds += gpu_start.elapsed().as_secs_f64();
-                        }
-                        if counts.iter().any(|&c| c > 0) {
-                            let _ = std::fs::write(std::env::temp_dir().join("veach-nonfinite-input.gltf"), &bytes);
-                            panic!(
-                                "input {round} renders non-finite samples {counts:?} (saved to veach-nonfinite-input.gltf)"
-                            );
-                        }
-                    }
-                    Ok(None) => {}
-                    Err(_) => {
-                        let _ = std::fs::write(std::env::temp_dir().join("veach-panic-input.gltf"), &bytes);
-                        panic!("input {round} panicked while rendering (saved to veach-panic-input.gltf)");
-                    }
-                }
+                // What loads renders without a panic and with no non-finite sample on the CPU
+                // engine (on the GPU: mutated_assets_never_panic_on_the_gpu).
+                render_mutated(round, &bytes, &scene, None);
             }
             Ok(Err(e)) => {
                 assert!(!e.is_empty() && !e.contains('\n'), "one line: {e}");
@@ -258,11 +257,36 @@ fn mutated_assets_never_panic() {
             }
         }
     }
+    eprintln!("{inputs} mutated inputs: {loaded} loaded, {refused} refused, {:.1} s", start.elapsed().as_secs_f64());
+    assert!(loaded > 100 && refused > 100, "the mutations exercise both outcomes");
+}
+
+/// The mutated inputs that load render on the GPU without a panic and with no non-finite
+/// sample, as many as fit a time budget (each GPU renderer compiles its pipeline: about a
+/// second on lavapipe), at least six. Loading them is mutated_assets_never_panic's business.
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn mutated_assets_never_panic_on_the_gpu() {
+    let Some(gpu_ctx) = common::gpu("mutated_assets_never_panic_on_the_gpu") else { return };
+    let (mut loaded, mut gpu_runs) = (0, 0usize);
+    let mut gpu_seconds = 0.0;
+    let start = std::time::Instant::now();
+    for (round, bytes) in mutated_inputs() {
+        if gpu_runs >= 6 && gpu_seconds >= GPU_BUDGET_SECONDS {
+            break;
+        }
+        let Ok(Ok(scene)) = std::panic::catch_unwind(|| load_bytes(&bytes, None)) else { continue };
+        loaded += 1;
+        let gpu_start = std::time::Instant::now();
+        if render_mutated(round, &bytes, &scene, Some(gpu_ctx.clone())) {
+            gpu_runs += 1;
+            gpu_seconds += gpu_start.elapsed().as_secs_f64();
+        }
+    }
     eprintln!(
-        "{inputs} mutated inputs: {loaded} loaded ({gpu_runs} also on the GPU), {refused} refused, {:.1} s",
+        "{loaded} mutated inputs loaded, {gpu_runs} rendered on the GPU in {gpu_seconds:.1} s, {:.1} s in all",
         start.elapsed().as_secs_f64()
     );
-    assert!(loaded > 100 && refused > 100, "the mutations exercise both outcomes");
 }
 
 /// The triangle's glTF with its buffer moved to `uri` (byteLength kept).
@@ -327,8 +351,7 @@ fn a_scene_without_nodes_is_empty_not_invalid() {
 /// collinear UVs under a normal map without tangents (generated tangents degenerate), a
 /// sliver triangle, a light seen edge-on. Both engines must take 0 non-finite samples:
 /// dropping them would hide a bias.
-#[test]
-fn degenerate_vertex_data_gives_no_non_finite_samples() {
+fn degenerate_vertex_data_on(ctx: Option<veach::gpu::GpuContext>) {
     use common::build::{GltfBuilder, MeshData};
     use std::f32::consts::FRAC_1_SQRT_2;
     let dir = tempfile::tempdir().unwrap();
@@ -377,14 +400,24 @@ fn degenerate_vertex_data_gives_no_non_finite_samples() {
     let packed = veach::PackedScene::new(&scene);
     let settings =
         veach::Settings { width: 48, height: 48, max_depth: 6, env_color: Some([0.3; 3]), ..Default::default() };
-    for ctx in [None, common::gpu("degenerate_vertex_data_gives_no_non_finite_samples")] {
-        let gpu = ctx.is_some();
-        let mut r = common::renderer(packed.clone(), &camera, &settings, ctx).unwrap();
-        r.render_samples(0, 32).unwrap();
-        let film = r.film().unwrap();
-        assert_eq!(film.nonfinite_samples(), 0, "gpu {gpu}: non-finite samples");
-        assert!(film.samples() == 32 && film.mean(24 * 48 + 24).max_element() > 0.0, "gpu {gpu}: an empty image");
-    }
+    let gpu = ctx.is_some();
+    let mut r = common::renderer(packed, &camera, &settings, ctx).unwrap();
+    r.render_samples(0, 32).unwrap();
+    let film = r.film().unwrap();
+    assert_eq!(film.nonfinite_samples(), 0, "gpu {gpu}: non-finite samples");
+    assert!(film.samples() == 32 && film.mean(24 * 48 + 24).max_element() > 0.0, "gpu {gpu}: an empty image");
+}
+
+#[test]
+fn degenerate_vertex_data_gives_no_non_finite_samples() {
+    degenerate_vertex_data_on(None);
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn degenerate_vertex_data_gives_no_non_finite_samples_on_the_gpu() {
+    let Some(ctx) = common::gpu("degenerate_vertex_data_gives_no_non_finite_samples_on_the_gpu") else { return };
+    degenerate_vertex_data_on(Some(ctx));
 }
 
 #[test]

@@ -28,17 +28,16 @@ fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")
 }
 
-/// The backend flags for these tests: the GPU when this machine has one (bit-exactness on
-/// one adapter is the claim), else the CPU.
-fn backend() -> &'static str {
-    if common::gpu("reliability").is_some() { "gpu" } else { "cpu" }
+/// Whether the GPU tests here have an adapter (`veach` opens its own; bit-exactness on one
+/// adapter is the claim).
+fn has_gpu(test: &str) -> bool {
+    common::gpu(test).is_some()
 }
 
-#[test]
-fn sample_ranges_and_tiles_merge_into_the_same_bytes() {
-    let d = temp_dir("merge");
+/// Sample ranges and tiles rendered with `--backend b` merge into the bytes of one render.
+fn merges_into_the_same_bytes(b: &str) {
+    let d = temp_dir(&format!("merge-{b}"));
     let scene = common::asset("cornell-box.gltf");
-    let b = backend();
     let base = ["--width", "40", "--height", "30", "--backend", b];
     let render = |out: &Path, extra: &[&str]| {
         let mut args = vec!["render", s(&scene), "-o", s(out)];
@@ -78,6 +77,19 @@ fn sample_ranges_and_tiles_merge_into_the_same_bytes() {
     assert_eq!(mixed.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&mixed.stderr).contains("sampler"));
     let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn sample_ranges_and_tiles_merge_into_the_same_bytes() {
+    merges_into_the_same_bytes("cpu");
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn sample_ranges_and_tiles_merge_into_the_same_bytes_on_the_gpu() {
+    if has_gpu("sample_ranges_and_tiles_merge_into_the_same_bytes_on_the_gpu") {
+        merges_into_the_same_bytes("gpu");
+    }
 }
 
 #[test]
@@ -123,40 +135,60 @@ fn sigint_keeps_the_work_and_resume_finishes_it_exactly() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-#[test]
-fn non_finite_samples_are_dropped_and_counted() {
+fn non_finite_samples_are_dropped_and_counted_on(backend: veach::Backend) {
     // A material that produces NaN (the loader would sanitise it; inject it after loading).
     let (mut scene, camera) = common::load_pair(&common::asset("cornell-box.gltf"), None).unwrap();
     scene.materials[0].base_color = Vec3::new(f32::NAN, 0.5, 0.5);
-    let mut renderers = vec![veach::Backend::Cpu];
-    if common::gpu("non_finite_samples_are_dropped_and_counted").is_some() {
-        renderers.push(veach::Backend::Gpu);
+    let packed = veach::packed::PackedScene::new(&scene);
+    let mut r = veach::Renderer::new(packed, &camera, &common::settings(24, 8, 0), backend).unwrap();
+    r.render_samples(0, 8).unwrap();
+    let film = r.film().unwrap();
+    assert!(film.nonfinite_samples() > 0, "{backend:?}: NaN paths are counted");
+    assert!((0..film.pixel_count()).all(|i| film.mean(i).is_finite()), "{backend:?}: the image stays finite");
+    assert_eq!(film.samples(), 8);
+}
+
+#[test]
+fn non_finite_samples_are_dropped_and_counted() {
+    non_finite_samples_are_dropped_and_counted_on(veach::Backend::Cpu);
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn non_finite_samples_are_dropped_and_counted_on_the_gpu() {
+    if has_gpu("non_finite_samples_are_dropped_and_counted_on_the_gpu") {
+        non_finite_samples_are_dropped_and_counted_on(veach::Backend::Gpu);
     }
-    for backend in renderers {
-        let packed = veach::packed::PackedScene::new(&scene);
-        let mut r = veach::Renderer::new(packed, &camera, &common::settings(24, 8, 0), backend).unwrap();
-        r.render_samples(0, 8).unwrap();
-        let film = r.film().unwrap();
-        assert!(film.nonfinite_samples() > 0, "{backend:?}: NaN paths are counted");
-        assert!((0..film.pixel_count()).all(|i| film.mean(i).is_finite()), "{backend:?}: the image stays finite");
-        assert_eq!(film.samples(), 8);
-    }
+}
+
+/// A film too large for memory fails with `--backend b` before any work, naming the limit.
+fn limits_fail_early_on(b: &str) {
+    let scene = common::asset("cornell-box.gltf");
+    let d = temp_dir(&format!("limits-{b}"));
+    let out = d.join("big.png");
+    let r = veach(&["render", s(&scene), "-o", s(&out), "--width", "16384", "--height", "16384", "--backend", b]);
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("16384") && stderr.contains("bytes"), "{stderr}");
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
 fn limits_fail_early_naming_the_limit() {
+    limits_fail_early_on("cpu");
     let scene = common::asset("cornell-box.gltf");
     let d = temp_dir("limits");
     let out = d.join("big.png");
-    for backend in ["cpu", backend()] {
-        let r =
-            veach(&["render", s(&scene), "-o", s(&out), "--width", "16384", "--height", "16384", "--backend", backend]);
-        let stderr = String::from_utf8_lossy(&r.stderr);
-        assert_eq!(r.status.code(), Some(2), "{stderr}");
-        assert!(stderr.contains("16384") && stderr.contains("bytes"), "{stderr}");
-        assert!(!out.exists());
-    }
     let r = veach(&["render", s(&scene), "-o", s(&out), "--width", "100000", "--height", "8"]);
     assert_eq!(r.status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn limits_fail_early_naming_the_limit_on_the_gpu() {
+    if has_gpu("limits_fail_early_naming_the_limit_on_the_gpu") {
+        limits_fail_early_on("gpu");
+    }
 }

@@ -59,7 +59,12 @@ fn glass_against_reference(ctx: Option<veach::gpu::GpuContext>, what: &str) {
 #[test]
 fn glass_cornell_box_matches_reference() {
     glass_against_reference(None, "glass cbox cpu");
-    if let Some(ctx) = gpu("glass_cornell_box_matches_reference") {
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn glass_cornell_box_matches_reference_on_the_gpu() {
+    if let Some(ctx) = gpu("glass_cornell_box_matches_reference_on_the_gpu") {
         glass_against_reference(Some(ctx), "glass cbox gpu");
     }
 }
@@ -202,6 +207,14 @@ fn clamped(
     render(&asset("cornell-glass.gltf"), &s, 1, ctx)
 }
 
+/// The direct and indirect limits the clamping tests set.
+const CLAMP_LIMITS: (f32, f32) = (0.01, 0.004);
+
+/// The most one sample's R+G+B may carry under the limits (see below).
+fn clamp_bound(direct: f32, indirect: f32) -> f32 {
+    (4.0 * direct + 18.0 * indirect) * (1.0 + 1e-4)
+}
+
 /// Firefly clamping caps every contribution by its kind and only ever removes light. A path
 /// of 8 segments adds at most 4 contributions of direct light (an emitter or the sky seen by
 /// the camera ray, next-event estimates at the first vertex, an emitter hit by its BSDF ray)
@@ -210,8 +223,8 @@ fn clamped(
 #[test]
 fn clamping_bounds_every_contribution_and_only_removes_light() {
     let sum = |v: Vec3| v.x + v.y + v.z;
-    let (direct, indirect) = (0.01f32, 0.004f32);
-    let bound = (4.0 * direct + 18.0 * indirect) * (1.0 + 1e-4);
+    let (direct, indirect) = CLAMP_LIMITS;
+    let bound = clamp_bound(direct, indirect);
     for seed in 0..2 {
         let free = clamped(None, None, 8, seed, None);
         let n = free.pixel_count();
@@ -232,9 +245,18 @@ fn clamping_bounds_every_contribution_and_only_removes_light() {
         assert!((0..n).all(|i| sum(c2.mean(i)) <= 3.0 * direct * (1.0 + 1e-4)));
         assert!((0..n).any(|i| sum(d2.mean(i)) > 3.0 * direct), "the direct limit must bind");
     }
-    if let Some(ctx) = gpu("clamping_bounds_every_contribution_and_only_removes_light") {
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn clamping_bounds_every_contribution_and_only_removes_light_on_the_gpu() {
+    let test = "clamping_bounds_every_contribution_and_only_removes_light_on_the_gpu";
+    let sum = |v: Vec3| v.x + v.y + v.z;
+    let (direct, indirect) = CLAMP_LIMITS;
+    let bound = clamp_bound(direct, indirect);
+    if let Some(ctx) = gpu(test) {
         let c = clamped(Some(direct), Some(indirect), 8, 0, Some(ctx));
-        let free = clamped(None, None, 8, 0, gpu("clamping_bounds_every_contribution_and_only_removes_light"));
+        let free = clamped(None, None, 8, 0, gpu(test));
         for i in 0..c.pixel_count() {
             assert!(sum(c.mean(i)) <= bound, "gpu pixel {i}: {} above {bound}", c.mean(i));
             assert!(c.mean(i).cmple(free.mean(i) * (1.0 + 1e-5) + 1e-6).all(), "gpu pixel {i} gained light");
