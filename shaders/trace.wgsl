@@ -2,8 +2,8 @@
 // traces a primary ray per pixel; 1 adds a shadow ray from its hit to a light sample; 2 adds a
 // cosine-distributed bounce ray from its hit. The host times the three and takes differences,
 // as the CPU twin (src/bench.rs, ray_throughput) times batches of the same kinds of rays.
-// Each pixel adds (primary hit + secondary hit or unblocked) to the film, so that no trace
-// is dead code and the host can count the secondary rays.
+// Each pixel adds (primary ray hit, secondary ray traced, secondary ray hit or unblocked) to
+// the film, so that no trace is dead code and the host counts the rays it traced.
 #include "integrator.wgsl"
 
 override TRACE_KIND: u32 = 0u;
@@ -17,9 +17,9 @@ fn trace_rays(@builtin(global_invocation_id) gid: vec3<u32>) {
     var sampler: Sampler;
     let ray = camera_sample(at.pixel, &sampler);
     let hit = intersect_closest(ray);
-    var count = 0.0;
+    var count = vec3<f32>(0.0);
     if (hit.tri != NO_HIT) {
-        count = 1.0;
+        count.x = 1.0;
         let tri = world_triangle(hit.tri, hit.instance);
         let n = normalize(cross(tri.e1, tri.e2));
         let ng = select(n, -n, dot(n, ray.dir) > 0.0);
@@ -27,15 +27,16 @@ fn trace_rays(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (TRACE_KIND == 1u && (params.light_count > 0u || params.tree_emitters > 0u || params.env_select > 0.0)) {
             let ctx = LightContext(point, ng, false);
             let ls = sample_light(ctx, vec3<f32>(sample_1d(&sampler), sample_2d(&sampler)));
-            if (ls.pdf > 0.0 && unoccluded(offset_ray(point, ng), ls)) {
-                count += 1.0;
+            // As the CPU column: only light samples with a density are traced.
+            if (ls.pdf > 0.0) {
+                count.y = 1.0;
+                count.z = select(0.0, 1.0, unoccluded(offset_ray(point, ng), ls));
             }
         } else if (TRACE_KIND == 2u) {
             let wi = from_local(frame_from_normal(ng), sample_cosine_hemisphere(sample_2d(&sampler)));
-            if (intersect_closest(Ray(offset_ray(point, ng), wi)).tri != NO_HIT) {
-                count += 1.0;
-            }
+            count.y = 1.0;
+            count.z = select(0.0, 1.0, intersect_closest(Ray(offset_ray(point, ng), wi)).tri != NO_HIT);
         }
     }
-    film_add_sample(at.slot, vec3<f32>(count));
+    film_add_sample(at.slot, count);
 }

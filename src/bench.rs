@@ -326,18 +326,22 @@ fn gpu_ray_throughput(g: &mut gpu::GpuRenderer) -> Result<Vec<RayResult>, Error>
         }
         Ok(t)
     };
+    // The film holds the last run's counts: a pixel adds 1 to its green channel for each
+    // secondary ray the kernel traced.
+    let traced = |g: &gpu::GpuRenderer| -> Result<usize, Error> {
+        let film = g.read_film()?;
+        Ok((0..film.pixel_count()).map(|i| film.sum(i).y).sum::<f64>() as usize)
+    };
     let primary_seconds = best(g, 0)?;
-    // The film still holds the last primary-only run: each primary ray that hit something left
-    // a 1 there and spawns one secondary ray in the other kernels.
-    let film = g.read_film()?;
-    let hits = (0..film.pixel_count()).map(|i| film.sum(i).x).sum::<f64>() as usize;
-    let primary = film.pixel_count() * PASSES as usize;
+    let primary = g.read_film()?.pixel_count() * PASSES as usize;
     let shadow_seconds = best(g, 1)? - primary_seconds;
+    let shadow = traced(g)?;
     let diffuse_seconds = best(g, 2)? - primary_seconds;
+    let diffuse = traced(g)?;
     Ok(vec![
         RayResult::new("primary", primary, primary_seconds),
-        RayResult::new("shadow", hits, shadow_seconds),
-        RayResult::new("diffuse", hits, diffuse_seconds),
+        RayResult::new("shadow", shadow, shadow_seconds),
+        RayResult::new("diffuse", diffuse, diffuse_seconds),
     ])
 }
 

@@ -518,9 +518,13 @@ fn bench_report(with_gpu: bool) {
         if with_gpu {
             let gpu = kinds("gpu_rays");
             assert_eq!(gpu.len(), 3, "{sc}");
-            // 16 passes of 16×16 primary rays; one secondary ray per primary hit.
+            // 16 passes of sample 0's 16×16 primary rays: the CPU's rays, 16 times (the twins'
+            // traversal may disagree on a ray grazing an edge).
             assert_eq!(gpu[0].1, 16.0 * 256.0);
-            assert!(gpu[1].1 > 0.0 && gpu[1].1 <= gpu[0].1 && gpu[1].1 == gpu[2].1, "{gpu:?}");
+            for k in 1..3 {
+                let (g, c) = (gpu[k].1, 16.0 * cpu[k].1);
+                assert!(g > 0.0 && (g - c).abs() <= 0.01 * c + 16.0, "{} rays: GPU {g}, CPU × 16 {c}", gpu[k].0);
+            }
         }
     }
 }

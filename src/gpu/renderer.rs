@@ -203,17 +203,19 @@ impl GpuRenderer {
     /// Renders sample indices `start .. start + count` (one dispatch each, and a settling
     /// dispatch after each convergence test of adaptive sampling) and waits.
     pub fn render_samples(&mut self, start: u32, count: u32) -> Result<(), Error> {
-        self.dispatch_samples(&self.pipeline, start, count, Some(self.taken))?;
+        self.dispatch_samples(&self.pipeline, start, 1, count, Some(self.taken))?;
         self.taken += count;
         Ok(())
     }
 
-    /// `count` dispatches of `pipeline` from sample index `start`, in batches of MAX_BATCH;
-    /// with `taken` (the samples pixels still sampling took before), settles the tests due.
+    /// `count` dispatches of `pipeline` at sample indices `start`, `start + step`, ... (step 0:
+    /// the same sample again), in batches of MAX_BATCH; with `taken` (the samples pixels still
+    /// sampling took before), settles the tests due.
     pub(super) fn dispatch_samples(
         &self,
         pipeline: &wgpu::ComputePipeline,
         start: u32,
+        step: u32,
         count: u32,
         taken: Option<u32>,
     ) -> Result<(), Error> {
@@ -224,7 +226,7 @@ impl GpuRenderer {
             let batch = (count - done).min(MAX_BATCH);
             let mut data = vec![0u8; (self.stride * batch as u64) as usize];
             for k in 0..batch {
-                let p = Params { sample_index: start + done + k, ..self.params };
+                let p = Params { sample_index: start + (done + k) * step, ..self.params };
                 let at = (self.stride * k as u64) as usize;
                 data[at..at + std::mem::size_of::<Params>()].copy_from_slice(bytemuck::bytes_of(&p));
             }

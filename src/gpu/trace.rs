@@ -23,7 +23,7 @@ impl GpuRenderer {
                 cache: None,
             });
             // Lavapipe compiles at first dispatch: one untimed pass.
-            self.dispatch_samples(&pipeline, 0, 1, None)?;
+            self.dispatch_samples(&pipeline, 0, 0, 1, None)?;
             self.ctx.check()?;
             self.trace_pipelines[k] = Some(pipeline);
         }
@@ -31,7 +31,8 @@ impl GpuRenderer {
         self.reset(self.params)?;
         let pipeline = self.trace_pipelines[k].as_ref().ok_or_else(|| Error::Gpu("no trace pipeline".into()))?;
         let t = std::time::Instant::now();
-        self.dispatch_samples(pipeline, 0, passes, None)?;
+        // Every pass traces sample 0's rays, the rays the CPU column traces.
+        self.dispatch_samples(pipeline, 0, 0, passes, None)?;
         Ok(t.elapsed().as_secs_f64())
     }
 }
