@@ -12,8 +12,14 @@
 // An invocation computes a 2×2 quad of pixels for DENOISE_BLOCKS output blocks: each weight
 // matrix it loads serves four pixels (loads are what costs on lavapipe, and what the
 // workgroup shares on real GPUs).
+//
+// Tensors and weights are stored as `tensor4`: vec4<f32>, or vec4<f16> where the device has
+// shader-f16 (the host then composes this file with `enable f16;` and the alias below
+// rewritten, halving the bytes read); arithmetic is f32 either way.
 
 const DENOISE_BLOCKS: u32 = 2u;
+
+alias tensor4 = vec4<f32>;
 
 struct ConvParams {
     // Output size before pooling; the input sources have it too (the upsampled one half).
@@ -31,15 +37,20 @@ struct ConvParams {
 }
 
 @group(0) @binding(0) var<storage, read> p: ConvParams;
-@group(0) @binding(1) var<storage, read> src_a: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> src_b: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read> weights: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read> src_a: array<tensor4>;
+@group(0) @binding(2) var<storage, read> src_b: array<tensor4>;
+@group(0) @binding(3) var<storage, read> weights: array<tensor4>;
 @group(0) @binding(4) var<storage, read> bias: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read_write> dst: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> dst: array<tensor4>;
 
 fn weight_matrix(ob: u32, tap: u32, ib: u32) -> mat4x4<f32> {
     let at = ((ob * 9u + tap) * (p.a_blocks + p.b_blocks) + ib) * 4u;
-    return mat4x4<f32>(weights[at], weights[at + 1u], weights[at + 2u], weights[at + 3u]);
+    return mat4x4<f32>(
+        vec4<f32>(weights[at]),
+        vec4<f32>(weights[at + 1u]),
+        vec4<f32>(weights[at + 2u]),
+        vec4<f32>(weights[at + 3u]),
+    );
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -78,12 +89,12 @@ fn conv3x3(@builtin(global_invocation_id) gid: vec3<u32>) {
                 var x = vec4<f32>(0.0);
                 if (inside[q]) {
                     if (ib < p.a_blocks) {
-                        x = src_a[src[q] * p.a_blocks + ib];
+                        x = vec4<f32>(src_a[src[q] * p.a_blocks + ib]);
                     } else {
                         // The skip source is at full resolution.
                         let sx = x0 + (q & 1u) + tap % 3u - 1u;
                         let sy = y0 + (q >> 1u) + tap / 3u - 1u;
-                        x = src_b[(sy * p.width + sx) * p.b_blocks + ib - p.a_blocks];
+                        x = vec4<f32>(src_b[(sy * p.width + sx) * p.b_blocks + ib - p.a_blocks]);
                     }
                 }
                 v[q] = x;
@@ -105,13 +116,15 @@ fn conv3x3(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (p.pool == 1u) {
             let top = max(acc[k], acc[DENOISE_BLOCKS + k]);
             let bottom = max(acc[2u * DENOISE_BLOCKS + k], acc[3u * DENOISE_BLOCKS + k]);
-            dst[((y0 / 2u) * (p.width / 2u) + x0 / 2u) * p.out_blocks + ob] = max(max(top, bottom), vec4<f32>(0.0));
+            let at = ((y0 / 2u) * (p.width / 2u) + x0 / 2u) * p.out_blocks + ob;
+            dst[at] = tensor4(max(max(top, bottom), vec4<f32>(0.0)));
         } else {
             for (var q = 0u; q < 4u; q++) {
                 let x = x0 + (q & 1u);
                 let y = y0 + (q >> 1u);
                 if (x < p.width && y < p.height) {
-                    dst[(y * p.width + x) * p.out_blocks + ob] = max(acc[q * DENOISE_BLOCKS + k], vec4<f32>(0.0));
+                    let v = max(acc[q * DENOISE_BLOCKS + k], vec4<f32>(0.0));
+                    dst[(y * p.width + x) * p.out_blocks + ob] = tensor4(v);
                 }
             }
         }

@@ -6,6 +6,7 @@ mod common;
 
 use sha2::{Digest, Sha256};
 use std::path::PathBuf;
+use veach::denoise::gpu::Precision;
 use veach::denoise::network::{Network, UNET_STEPS};
 use veach::denoise::tza::{self, Tensor};
 use veach::denoise::{Images, Options, Quality, denoise_cpu, plan_tiles};
@@ -301,7 +302,7 @@ fn the_wgsl_network_matches_the_rust_twin() {
             normal: aux.then_some(&normal[..]),
         };
         let net = veach::denoise::network(quality, images.channels()).unwrap();
-        let mut gpu = veach::denoise::gpu::GpuDenoiser::new(&ctx, &net).unwrap();
+        let mut gpu = veach::denoise::gpu::GpuDenoiser::with_precision(&ctx, &net, Precision::F32).unwrap();
         if bands {
             gpu.dispatch_macs = 2e6;
         }
@@ -313,6 +314,24 @@ fn the_wgsl_network_matches_the_rust_twin() {
         eprintln!("{quality:?} aux {aux} bands {bands}: worst {rel:.2e}; {e:.3} of the tolerance");
         assert!(e <= 1.0, "{quality:?} aux {aux}: {e} × the tolerance");
     }
+    // With f16 tensors (where the device has shader-f16; lavapipe does): the activations round
+    // to 11 bits. Tolerance 1e-2 of |value| + 1e-3; measured 3.0e-3 of |value| + 0.01.
+    if ctx.device.features().contains(wgpu::Features::SHADER_F16) {
+        let images = Images { width: w, height: h, color: &color, albedo: Some(&albedo), normal: Some(&normal) };
+        for quality in [Quality::Fast, Quality::Balanced] {
+            let net = veach::denoise::network(quality, 9).unwrap();
+            let gpu = veach::denoise::gpu::GpuDenoiser::with_precision(&ctx, &net, Precision::F16).unwrap();
+            let options = Options { quality, input_scale: None, max_tile_pixels: None };
+            let ours = gpu.denoise(&images, &options).unwrap();
+            let twin = denoise_cpu(&images, &options).unwrap();
+            let rel = worst(&ours, &twin, 1e-2);
+            let e = ours.iter().zip(&twin).map(|(x, y)| (x - y).abs() / (1e-2 * y.abs() + 1e-3)).fold(0.0, f32::max);
+            eprintln!("f16 {quality:?}: worst {rel:.2e}; {e:.3} of the tolerance");
+            assert!(e <= 1.0, "f16 {quality:?}: {e} × the tolerance");
+        }
+    } else {
+        eprintln!("the adapter has no shader-f16: the f16 path is not exercised here");
+    }
     // In two tiles on the device, against the twin's whole image.
     let (w, h) = (320, 32);
     let (color, albedo, normal) = noise_image(w, h, 9);
@@ -320,7 +339,9 @@ fn the_wgsl_network_matches_the_rust_twin() {
     let whole = Options { quality: Quality::Fast, input_scale: Some(0.8), max_tile_pixels: None };
     let tiled = Options { max_tile_pixels: Some(260 * 32), ..whole };
     assert_eq!(plan_tiles(w, h, 260 * 32).len(), 2);
-    let ours = veach::denoise::denoise(&images, &tiled, veach::denoise::Engine::Gpu(&ctx)).unwrap();
+    let net = veach::denoise::network(Quality::Fast, 9).unwrap();
+    let gpu = veach::denoise::gpu::GpuDenoiser::with_precision(&ctx, &net, Precision::F32).unwrap();
+    let ours = gpu.denoise(&images, &tiled).unwrap();
     let twin = denoise_cpu(&images, &whole).unwrap();
     let e = ours.iter().zip(&twin).map(|(x, y)| (x - y).abs() / (1e-4 * y.abs() + 1e-4)).fold(0.0, f32::max);
     assert!(e <= 1.0, "tiled on the GPU: {e} × the tolerance");

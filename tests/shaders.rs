@@ -62,3 +62,16 @@ fn shader_errors_name_the_file_and_line() {
 fn include_step_reports_unknown_files() {
     assert!(compose("no-such-file.wgsl").is_err());
 }
+
+/// The denoiser's f16 variant (tensors stored as vec4<f16> on devices with shader-f16)
+/// parses and validates with naga's f16 capability, and is the f32 kernel otherwise.
+#[test]
+fn the_denoiser_s_f16_variant_validates() {
+    let src = veach::gpu::shaders::denoise_source(true).unwrap();
+    assert!(src.starts_with("enable f16;") && src.contains("alias tensor4 = vec4<f16>;"));
+    let module = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::SHADER_FLOAT16)
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    assert_eq!(veach::gpu::shaders::denoise_source(false).unwrap(), compose(veach::gpu::shaders::DENOISE).unwrap());
+}

@@ -71,6 +71,40 @@ pub fn pack_weights(weight: &[f32], inputs: usize, outputs: usize, split: usize)
     out
 }
 
+/// How the device stores tensors and weights (arithmetic is f32 either way).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precision {
+    F32,
+    /// Half the bytes read; OIDN's weights are f16 already, so only the activations round.
+    F16,
+}
+
+impl Precision {
+    /// Bytes of one vec4 of a tensor.
+    fn vec4_bytes(self) -> usize {
+        match self {
+            Precision::F32 => 16,
+            Precision::F16 => 8,
+        }
+    }
+
+    /// `values` as this precision's bytes.
+    fn bytes(self, values: &[f32]) -> Vec<u8> {
+        match self {
+            Precision::F32 => bytemuck::cast_slice(values).to_vec(),
+            Precision::F16 => values.iter().flat_map(|v| half::f16::from_f32(*v).to_le_bytes()).collect(),
+        }
+    }
+
+    /// Bytes of this precision as f32 values.
+    fn values(self, bytes: &[u8]) -> Vec<f32> {
+        match self {
+            Precision::F32 => bytemuck::cast_slice(bytes).to_vec(),
+            Precision::F16 => bytes.chunks_exact(2).map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32()).collect(),
+        }
+    }
+}
+
 /// The network's weights and the pipeline on one device.
 pub struct GpuDenoiser {
     ctx: GpuContext,
@@ -78,16 +112,30 @@ pub struct GpuDenoiser {
     layout: wgpu::BindGroupLayout,
     weights: Vec<(wgpu::Buffer, wgpu::Buffer)>,
     net: Network,
+    precision: Precision,
     /// The most multiply-adds of one dispatch (`DISPATCH_MACS`; tests lower it to cut every
     /// layer into bands).
     pub dispatch_macs: f64,
 }
 
 impl GpuDenoiser {
+    /// The network on `ctx`'s device: tensors in f16 where the device has shader-f16.
     pub fn new(ctx: &GpuContext, net: &Network) -> Result<GpuDenoiser, Error> {
+        let f16 = ctx.device.features().contains(wgpu::Features::SHADER_F16);
+        Self::with_precision(ctx, net, if f16 { Precision::F16 } else { Precision::F32 })
+    }
+
+    pub fn with_precision(ctx: &GpuContext, net: &Network, precision: Precision) -> Result<GpuDenoiser, Error> {
         let device = &ctx.device;
-        let module =
-            crate::gpu::shaders::module(ctx, crate::gpu::shaders::DENOISE, crate::gpu::shaders::Geometry::Buffers)?;
+        if precision == Precision::F16 && !device.features().contains(wgpu::Features::SHADER_F16) {
+            return Err(Error::Gpu(format!("{} has no shader-f16 for f16 tensors", ctx.info.name)));
+        }
+        let source = crate::gpu::shaders::denoise_source(precision == Precision::F16).map_err(Error::Gpu)?;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("denoise"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        ctx.check()?;
         let storage = |binding: u32, read_only: bool, dynamic: bool| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -129,23 +177,36 @@ impl GpuDenoiser {
             let mut b = c.bias.clone();
             b.resize(blocks(c.outputs) * 4, 0.0);
             weights.push((
-                crate::gpu::storage_buffer(device, "denoise weights", bytemuck::cast_slice(&w))?,
+                crate::gpu::storage_buffer(device, "denoise weights", &precision.bytes(&w))?,
                 crate::gpu::storage_buffer(device, "denoise bias", bytemuck::cast_slice(&b))?,
             ));
         }
         ctx.check()?;
-        Ok(GpuDenoiser { ctx: ctx.clone(), pipeline, layout, weights, net: net.clone(), dispatch_macs: DISPATCH_MACS })
+        Ok(GpuDenoiser {
+            ctx: ctx.clone(),
+            pipeline,
+            layout,
+            weights,
+            net: net.clone(),
+            precision,
+            dispatch_macs: DISPATCH_MACS,
+        })
+    }
+
+    pub fn precision(&self) -> Precision {
+        self.precision
     }
 
     /// Bytes of the tensors of a `width`×`height` tile (sides multiples of 16): the input,
     /// and every step's output at its resolution.
     fn tile_bytes(&self, width: usize, height: usize) -> (u64, u64) {
         let lv = levels();
-        let mut total = (width * height * blocks(self.net.input_channels) * 16) as u64;
+        let vec4 = self.precision.vec4_bytes();
+        let mut total = (width * height * blocks(self.net.input_channels) * vec4) as u64;
         let mut largest = total;
         for (k, c) in self.net.convs.iter().enumerate() {
             let pixels = (width >> lv[k]) * (height >> lv[k]);
-            let bytes = (pixels * blocks(c.outputs) * 16) as u64;
+            let bytes = (pixels * blocks(c.outputs) * vec4) as u64;
             total += bytes;
             largest = largest.max(bytes);
         }
@@ -218,9 +279,10 @@ impl GpuDenoiser {
         }
         let input_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("denoise input"),
-            contents: bytemuck::cast_slice(&blocked),
+            contents: &self.precision.bytes(&blocked),
             usage: wgpu::BufferUsages::STORAGE,
         });
+        let vec4 = self.precision.vec4_bytes();
         let lv = levels();
         let outputs: Vec<wgpu::Buffer> = self
             .net
@@ -228,7 +290,7 @@ impl GpuDenoiser {
             .iter()
             .enumerate()
             .map(|(k, c)| {
-                let bytes = ((w >> lv[k]) * (h >> lv[k]) * blocks(c.outputs) * 16).max(16) as u64;
+                let bytes = ((w >> lv[k]) * (h >> lv[k]) * blocks(c.outputs) * vec4).max(16) as u64;
                 device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(c.name),
                     size: bytes,
@@ -350,7 +412,7 @@ impl GpuDenoiser {
             .map_err(|e| Error::Gpu(format!("denoise readback: {e}")))?;
         let values = {
             let view = readback.slice(..).get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?;
-            bytemuck::cast_slice::<u8, f32>(&view).to_vec()
+            self.precision.values(&view)
         };
         readback.unmap();
         Ok(values)

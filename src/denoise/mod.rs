@@ -120,6 +120,14 @@ impl Engine<'_> {
             Engine::Gpu(_) => "gpu",
         }
     }
+
+    /// How the engine stores tensors: f32, or f16 on a device with shader-f16.
+    pub fn precision(&self) -> &'static str {
+        match self {
+            Engine::Gpu(ctx) if ctx.device.features().contains(wgpu::Features::SHADER_F16) => "f16",
+            _ => "f32",
+        }
+    }
 }
 
 /// Denoises `images` on `engine`.

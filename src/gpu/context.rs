@@ -101,6 +101,9 @@ impl GpuContext {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("veach"),
             required_limits: limits,
+            // f16 arithmetic and storage where the adapter has them: the denoiser keeps its
+            // tensors in f16 there (half the bytes read).
+            required_features: adapter.features() & wgpu::Features::SHADER_F16,
             ..Default::default()
         }))
         .map_err(|e| Error::Gpu(format!("cannot open {}: {e}", info.name)))?;

@@ -147,6 +147,20 @@ fn include(
     Ok(())
 }
 
+/// The denoiser's layer kernel, its tensors stored in f16 when `f16` (the device has
+/// shader-f16): `enable f16;` first, and its storage alias rewritten.
+pub fn denoise_source(f16: bool) -> Result<String, String> {
+    let source = compose(DENOISE)?;
+    if !f16 {
+        return Ok(source);
+    }
+    const ALIAS: &str = "alias tensor4 = vec4<f32>;";
+    if !source.contains(ALIAS) {
+        return Err(format!("{DENOISE} has no `{ALIAS}` to store f16 in"));
+    }
+    Ok(format!("enable f16;\n{}", source.replace(ALIAS, "alias tensor4 = vec4<f16>;")))
+}
+
 /// The kernel `entry` as a shader module on `ctx`'s device; a compile error names the shader
 /// file and line.
 pub fn module(ctx: &super::GpuContext, entry: &str, geometry: Geometry) -> Result<wgpu::ShaderModule, crate::Error> {

@@ -65,6 +65,7 @@ pub fn run(options: ViewOptions) -> Result<(), Error> {
     setup.device_descriptor = Arc::new(|adapter: &wgpu::Adapter| wgpu::DeviceDescriptor {
         label: Some("veach viewer"),
         required_limits: adapter.limits(),
+        required_features: adapter.features() & wgpu::Features::SHADER_F16,
         ..Default::default()
     });
     let native = eframe::NativeOptions {

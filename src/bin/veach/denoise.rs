@@ -72,6 +72,7 @@ pub fn run(args: &DenoiseArgs) -> Result<(), Error> {
             "network": network,
             "quality": args.denoise_quality.name(),
             "denoise_engine": engine.name(),
+            "denoise_precision": engine.precision(),
             "denoise_engine_reason": reason,
             "denoise_seconds": seconds,
             "inputs": images.channels(),
