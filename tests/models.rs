@@ -9,16 +9,7 @@ use std::path::PathBuf;
 use veach::Settings;
 
 fn models_dir() -> Option<PathBuf> {
-    let d = common::root().join("../shared/models");
-    if d.is_dir() {
-        Some(d)
-    } else {
-        if std::env::var("VEACH_REQUIRE_MODELS").as_deref() == Ok("1") {
-            panic!("VEACH_REQUIRE_MODELS=1 but {} is absent", d.display());
-        }
-        eprintln!("SKIPPED: {} is absent (third-party models are not in the repository)", d.display());
-        None
-    }
+    common::shared_models()
 }
 
 /// Every .gltf/.glb one level below `dir`.

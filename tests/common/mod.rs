@@ -20,6 +20,21 @@ pub fn asset(name: &str) -> PathBuf {
     root().join("assets").join(name)
 }
 
+/// The third-party models of ../shared/models, or None (after saying so) where the folder is
+/// absent; with VEACH_REQUIRE_MODELS=1 (CI) its absence fails the test instead.
+pub fn shared_models() -> Option<PathBuf> {
+    let d = root().join("../shared/models");
+    if d.is_dir() {
+        Some(d)
+    } else {
+        if std::env::var("VEACH_REQUIRE_MODELS").as_deref() == Ok("1") {
+            panic!("VEACH_REQUIRE_MODELS=1 but {} is absent", d.display());
+        }
+        eprintln!("SKIPPED: {} is absent (third-party models are not in the repository)", d.display());
+        None
+    }
+}
+
 /// A GPU context, or None (after saying why) when this machine has no Vulkan adapter.
 /// With VEACH_REQUIRE_GPU=1 (CI) a missing adapter fails the test instead.
 pub fn gpu(test: &str) -> Option<GpuContext> {

@@ -15,12 +15,17 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_pbrSpecularGlossiness",
     "KHR_materials_anisotropy",
     "KHR_materials_iridescence",
+    "KHR_mesh_quantization",
+    "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
+    "KHR_draco_mesh_compression",
+    "EXT_texture_webp",
+    "KHR_texture_basisu",
 ];
 
 /// Extensions veach knows and ignores for now; files that merely use them render, with one
 /// warning each.
-const KNOWN_UNIMPLEMENTED: &[&str] =
-    &["KHR_materials_dispersion", "KHR_materials_variants", "KHR_texture_basisu", "EXT_texture_webp"];
+const KNOWN_UNIMPLEMENTED: &[&str] = &["KHR_materials_dispersion", "KHR_materials_variants"];
 
 /// Required extensions veach cannot honour are an error naming them; used ones it does not
 /// know get one warning each.

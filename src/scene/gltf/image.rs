@@ -14,6 +14,10 @@ pub fn decode_image(
 ) -> Result<Texture, String> {
     use image::DynamicImage;
     let encoded = resources::image_bytes(image, buffers, base)?;
+    let name = image.name().map(str::to_string).unwrap_or_else(|| format!("image {}", image.index()));
+    if encoded.starts_with(&KTX2_MAGIC) {
+        return decode_ktx2(&encoded, name);
+    }
     let mut reader = image::ImageReader::new(std::io::Cursor::new(&encoded[..]))
         .with_guessed_format()
         .map_err(|e| format!("cannot decode: {e}"))?;
@@ -98,7 +102,25 @@ pub fn decode_image(
         };
         rgba.extend_from_slice(&texel);
     }
-    let name = image.name().map(str::to_string).unwrap_or_else(|| format!("image {}", image.index()));
+    Ok(Texture { name, width: w, height: h, rgba })
+}
+
+/// The identifier that opens every KTX2 file.
+const KTX2_MAGIC: [u8; 12] = [0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
+
+/// A KTX2 image of KHR_texture_basisu (Basis Universal: ETC1S or UASTC), its first level
+/// transcoded to 8-bit RGBA by the pure-Rust `basisu` transcoder.
+fn decode_ktx2(encoded: &[u8], name: String) -> Result<Texture, String> {
+    let fail = |e: basisu::Error| format!("cannot decode KTX2/Basis Universal: {e:?}");
+    let transcoder = basisu::Transcoder::new(encoded).map_err(fail)?;
+    let (w, h) = transcoder.base_dimensions();
+    if w == 0 || h == 0 || w > MAX_DECODED_IMAGE_SIDE || h > MAX_DECODED_IMAGE_SIDE {
+        return Err(format!("{w}×{h} pixels is outside 1..{MAX_DECODED_IMAGE_SIDE}"));
+    }
+    let rgba = transcoder.transcode(0, basisu::TargetFormat::Rgba32, basisu::DecodeFlags::NONE).map_err(fail)?;
+    if rgba.len() != (w * h * 4) as usize {
+        return Err(format!("transcoded to {} bytes, not {w}×{h} RGBA", rgba.len()));
+    }
     Ok(Texture { name, width: w, height: h, rgba })
 }
 

@@ -1,18 +1,173 @@
-//! glTF mesh primitives as world-space triangles: accessors checked before they are read,
-//! triangulation of every mode, normals and tangents filled in.
+//! glTF mesh primitives as world-space triangles: accessors read through `accessor.rs` (any
+//! component type, sparse, meshopt) or a Draco stream, morph targets at their default weights,
+//! skins at the rest pose, triangulation of every mode, normals and tangents filled in.
 
 use super::MAX_TRIANGLES;
+use super::accessor::{Views, read_floats, read_uints};
 use crate::scene::tangents::generate_tangents;
 use crate::scene::{Scene, Triangle};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
+/// What mesh loading reads besides the mesh: the document (Draco's views), every buffer
+/// view's bytes, and every node's world transform (skins' joints).
+pub struct MeshSources<'a> {
+    pub doc: &'a gltf::Document,
+    pub views: &'a Views<'a>,
+    pub globals: &'a [Mat4],
+}
+
+/// A primitive's vertex data in the mesh's own space: morph targets applied (at the node's
+/// or the mesh's default weights), from its accessors or its Draco stream.
+struct Vertices {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    uvs: Option<Vec<Vec2>>,
+    tangents: Option<Vec<Vec4>>,
+    indices: Vec<u32>,
+    /// Per vertex, up to eight (joint, weight) influences (JOINTS_0/1, WEIGHTS_0/1).
+    skin: Option<Vec<[(u32, f32); 8]>>,
+}
+
+fn rows<const N: usize>(flat: Vec<f32>) -> Vec<[f32; N]> {
+    flat.chunks_exact(N).map(|c| std::array::from_fn(|i| c[i])).collect()
+}
+
+fn read_vertices(
+    prim: &gltf::Primitive,
+    src: &MeshSources,
+    weights: Option<&[f32]>,
+    name: &str,
+) -> Result<Option<Vertices>, String> {
+    use gltf::Semantic;
+    let draco = super::draco::decode_primitive(prim, src.doc, src.views).map_err(|e| format!("{name}: {e}"))?;
+    let attr = |semantic: Semantic, comps: usize| -> Result<Option<Vec<f32>>, String> {
+        let key = semantic.to_string();
+        if let Some(values) = draco.as_ref().and_then(|d| d.attributes.get(&key)) {
+            return Ok(Some(values.clone()));
+        }
+        match prim.get(&semantic) {
+            Some(a) => read_floats(&a, src.views, comps)
+                .map(Some)
+                .map_err(|e| format!("{name}: {key} accessor {}: {e}", a.index())),
+            None => Ok(None),
+        }
+    };
+    let Some(positions) = attr(Semantic::Positions, 3)? else {
+        return Ok(None);
+    };
+    let mut positions: Vec<Vec3> = rows::<3>(positions).into_iter().map(Vec3::from).collect();
+    let nv = positions.len();
+    let same = |v: &Vec<f32>, comps: usize| v.len() == nv * comps;
+    let mut normals: Option<Vec<Vec3>> =
+        attr(Semantic::Normals, 3)?.filter(|v| same(v, 3)).map(|v| rows::<3>(v).into_iter().map(Vec3::from).collect());
+    let uvs: Option<Vec<Vec2>> = attr(Semantic::TexCoords(0), 2)?
+        .filter(|v| same(v, 2))
+        .map(|v| rows::<2>(v).into_iter().map(Vec2::from).collect());
+    let mut tangents: Option<Vec<Vec4>> =
+        attr(Semantic::Tangents, 4)?.filter(|v| same(v, 4)).map(|v| rows::<4>(v).into_iter().map(Vec4::from).collect());
+    let indices: Vec<u32> = match (&draco, prim.indices()) {
+        (Some(d), _) => d.indices.clone(),
+        (None, Some(a)) => {
+            read_uints(&a, src.views, 1).map_err(|e| format!("{name}: indices accessor {}: {e}", a.index()))?
+        }
+        (None, None) => (0..nv as u32).collect(),
+    };
+    // Morph targets at the default weights: displacements added before skinning.
+    for (k, target) in prim.morph_targets().enumerate() {
+        let w = weights.and_then(|w| w.get(k)).copied().unwrap_or(0.0);
+        if w == 0.0 || !w.is_finite() {
+            continue;
+        }
+        let delta = |a: Option<gltf::Accessor>| -> Result<Option<Vec<Vec3>>, String> {
+            let Some(a) = a else { return Ok(None) };
+            let v = read_floats(&a, src.views, 3)
+                .map_err(|e| format!("{name}: morph target {k} accessor {}: {e}", a.index()))?;
+            Ok(same(&v, 3).then(|| rows::<3>(v).into_iter().map(Vec3::from).collect()))
+        };
+        if let Some(d) = delta(target.positions())? {
+            positions.iter_mut().zip(&d).for_each(|(p, d)| *p += w * *d);
+        }
+        if let (Some(n), Some(d)) = (&mut normals, delta(target.normals())?) {
+            n.iter_mut().zip(&d).for_each(|(n, d)| *n += w * *d);
+        }
+        if let (Some(t), Some(d)) = (&mut tangents, delta(target.tangents())?) {
+            t.iter_mut().zip(&d).for_each(|(t, d)| *t += (w * *d).extend(0.0));
+        }
+    }
+    // Skin influences: JOINTS_n (unsigned integers) with WEIGHTS_n.
+    let mut skin: Option<Vec<[(u32, f32); 8]>> = None;
+    for set in 0..2u32 {
+        let joints = match prim.get(&Semantic::Joints(set)) {
+            Some(a) => {
+                read_uints(&a, src.views, 4).map_err(|e| format!("{name}: JOINTS_{set} accessor {}: {e}", a.index()))?
+            }
+            None => continue,
+        };
+        let Some(w) = attr(Semantic::Weights(set), 4)? else { continue };
+        if joints.len() != nv * 4 || w.len() != nv * 4 {
+            return Err(format!("{name}: JOINTS_{set}/WEIGHTS_{set} do not have one entry a vertex"));
+        }
+        let s = skin.get_or_insert_with(|| vec![[(0, 0.0); 8]; nv]);
+        for (v, influences) in s.iter_mut().enumerate() {
+            for c in 0..4 {
+                influences[set as usize * 4 + c] = (joints[v * 4 + c], w[v * 4 + c]);
+            }
+        }
+    }
+    Ok(Some(Vertices { positions, normals, uvs, tangents, indices, skin }))
+}
+
+/// The joint matrices of a skin (each joint's world transform times its inverse bind
+/// matrix), indexed as JOINTS_n index them.
+fn joint_matrices(skin: &gltf::Skin, src: &MeshSources) -> Result<Vec<Mat4>, String> {
+    let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
+    let inverse_bind: Vec<Mat4> = match skin.inverse_bind_matrices() {
+        Some(a) => rows::<16>(
+            read_floats(&a, src.views, 16).map_err(|e| format!("skin {}: inverse bind matrices: {e}", skin.index()))?,
+        )
+        .into_iter()
+        .map(|m| Mat4::from_cols_array(&m))
+        .collect(),
+        None => vec![Mat4::IDENTITY; joints.len()],
+    };
+    if inverse_bind.len() < joints.len() {
+        return Err(format!(
+            "skin {}: {} inverse bind matrices for {} joints",
+            skin.index(),
+            inverse_bind.len(),
+            joints.len()
+        ));
+    }
+    joints
+        .iter()
+        .zip(inverse_bind)
+        .map(|(&j, ibm)| {
+            let world = src
+                .globals
+                .get(j)
+                .copied()
+                .ok_or_else(|| format!("skin {}: joint node {j} is missing", skin.index()))?;
+            Ok(world * ibm)
+        })
+        .collect()
+}
+
+/// Loads a node's mesh as world-space triangles: the node's transform `world`, or for a
+/// skinned mesh its skin's joints at the rest pose (the node's own transform is then ignored,
+/// as glTF specifies); morph targets at the default weights.
 pub fn load_mesh(
     mesh: &gltf::Mesh,
     world: Mat4,
-    buffers: &[gltf::buffer::Data],
+    node: Option<&gltf::Node>,
+    src: &MeshSources,
     default_material: u32,
     scene: &mut Scene,
 ) -> Result<(), String> {
+    let weights = node.and_then(|n| n.weights()).or_else(|| mesh.weights());
+    let joints = match node.and_then(|n| n.skin()) {
+        Some(skin) => Some(joint_matrices(&skin, src)?),
+        None => None,
+    };
     let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
     // A mirroring transform flips the winding; swap two vertices to keep the front face.
     let mirrored = Mat3::from_mat4(world).determinant() < 0.0;
@@ -23,48 +178,56 @@ pub fn load_mesh(
             continue; // points and lines have no area to render
         }
         let name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
-        // Check every accessor we read against its buffer before the reader touches it.
-        use gltf::accessor::Dimensions;
-        let attrs = [
-            ("POSITION", prim.get(&gltf::Semantic::Positions), Dimensions::Vec3),
-            ("NORMAL", prim.get(&gltf::Semantic::Normals), Dimensions::Vec3),
-            ("TEXCOORD_0", prim.get(&gltf::Semantic::TexCoords(0)), Dimensions::Vec2),
-            ("TANGENT", prim.get(&gltf::Semantic::Tangents), Dimensions::Vec4),
-            ("indices", prim.indices(), Dimensions::Scalar),
-        ];
-        for (what, accessor, dims) in attrs {
-            if let Some(a) = accessor {
-                check_accessor(&a, Some(dims), buffers)
-                    .map_err(|e| format!("{name}: {what} accessor {}: {e}", a.index()))?;
-            }
-        }
-        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-        let Some(positions) = reader.read_positions() else {
+        let Some(v) = read_vertices(&prim, src, weights, &name)? else {
             continue;
         };
-        let positions: Vec<Vec3> = positions.map(|p| world.transform_point3(Vec3::from(p))).collect();
-        let nv = positions.len();
-        let normals: Option<Vec<Vec3>> = reader
-            .read_normals()
-            .map(|n| n.map(|n| (normal_matrix * Vec3::from(n)).normalize_or_zero()).collect())
-            .filter(|n: &Vec<Vec3>| n.len() == nv);
-        let uvs: Option<Vec<Vec2>> = reader
-            .read_tex_coords(0)
-            .map(|t| t.into_f32().map(Vec2::from).collect())
-            .filter(|t: &Vec<Vec2>| t.len() == nv);
-        let indices: Vec<u32> = match reader.read_indices() {
-            Some(i) => i.into_u32().collect(),
-            None => (0..nv as u32).collect(),
+        let nv = v.positions.len();
+        // Per vertex: the transform of its point (the node's, or its skin's blend of joints).
+        let skinned: Option<Vec<Mat4>> = match (&joints, &v.skin) {
+            (Some(joints), Some(influences)) => Some(
+                influences
+                    .iter()
+                    .map(|inf| {
+                        let mut m = Mat4::ZERO;
+                        for &(j, w) in inf {
+                            if w != 0.0 {
+                                let jm = joints
+                                    .get(j as usize)
+                                    .ok_or_else(|| format!("{name}: joint {j} is out of range"))?;
+                                m += *jm * w;
+                            }
+                        }
+                        Ok(m)
+                    })
+                    .collect::<Result<_, String>>()?,
+            ),
+            _ => None,
         };
-        let mut tris = triangulate(&indices, mode);
+        let point_to_world = |i: usize| skinned.as_ref().map_or(world, |m| m[i]);
+        let positions: Vec<Vec3> = (0..nv).map(|i| point_to_world(i).transform_point3(v.positions[i])).collect();
+        let normals: Option<Vec<Vec3>> = v.normals.as_ref().map(|ns| {
+            ns.iter()
+                .enumerate()
+                .map(|(i, n)| {
+                    let m = match &skinned {
+                        Some(ms) => Mat3::from_mat4(ms[i]).inverse().transpose(),
+                        None => normal_matrix,
+                    };
+                    (m * *n).normalize_or_zero()
+                })
+                .collect()
+        });
+        let uvs = v.uvs;
+        let mut tris = triangulate(&v.indices, mode);
         if scene.triangles.len() + tris.len() > MAX_TRIANGLES {
             return Err(format!("more than {MAX_TRIANGLES} triangles"));
         }
         if let Some(bad) = tris.iter().flatten().find(|&&i| i as usize >= nv) {
             return Err(format!("{name}: index {bad} is out of range ({nv} vertices)"));
         }
-        if mirrored {
-            for t in &mut tris {
+        for t in &mut tris {
+            let m = point_to_world(t[0] as usize);
+            if (skinned.is_some() && Mat3::from_mat4(m).determinant() < 0.0) || (skinned.is_none() && mirrored) {
                 t.swap(1, 2);
             }
         }
@@ -78,17 +241,21 @@ pub fn load_mesh(
         // transform flips the bitangent's handedness), else generated from UVs.
         let tangents: Option<Vec<Vec4>> = match (&uvs, wants_tangents) {
             (Some(uvs), true) => {
-                let given: Option<Vec<Vec4>> = reader
-                    .read_tangents()
-                    .map(|t| {
-                        t.map(|t| {
-                            let v = (Mat3::from_mat4(world) * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
-                            let w = if (t[3] < 0.0) != mirrored { -1.0 } else { 1.0 };
-                            v.extend(w)
-                        })
-                        .collect()
+                let given: Option<Vec<Vec4>> = v
+                    .tangents
+                    .as_ref()
+                    .map(|ts| {
+                        ts.iter()
+                            .enumerate()
+                            .map(|(i, t)| {
+                                let m = Mat3::from_mat4(point_to_world(i));
+                                let d = (m * t.truncate()).normalize_or_zero();
+                                let w = if (t.w < 0.0) != (m.determinant() < 0.0) { -1.0 } else { 1.0 };
+                                d.extend(w)
+                            })
+                            .collect()
                     })
-                    .filter(|t: &Vec<Vec4>| t.len() == nv && t.iter().all(|v| v.is_finite()));
+                    .filter(|t: &Vec<Vec4>| t.iter().all(|v| v.is_finite()));
                 Some(given.unwrap_or_else(|| {
                     let vertex_normals = normals.clone().unwrap_or_else(|| face_normals_per_vertex(&positions, &tris));
                     generate_tangents(&positions, &vertex_normals, uvs, &tris)
@@ -119,55 +286,6 @@ pub fn load_mesh(
             let tangents = tangents.as_ref().map_or([Vec4::ZERO; 3], |t| idx.map(|i| t[i as usize]));
             scene.triangles.push(Triangle { positions: p, normals: n, uvs: uv, tangents, material });
         }
-    }
-    Ok(())
-}
-
-/// An accessor's bytes lie inside its view, and its view inside its buffer; its type is one
-/// veach reads.
-fn check_accessor(
-    a: &gltf::Accessor,
-    dims: Option<gltf::accessor::Dimensions>,
-    buffers: &[gltf::buffer::Data],
-) -> Result<(), String> {
-    use gltf::accessor::{DataType, Dimensions};
-    if a.sparse().is_some() {
-        return Err("sparse accessors are not supported".into());
-    }
-    if let Some(d) = dims
-        && a.dimensions() != d
-    {
-        return Err(format!("is {:?}, expected {:?}", a.dimensions(), d));
-    }
-    let ok_type = match a.dimensions() {
-        Dimensions::Scalar => matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32),
-        // Texture coordinates may be normalised integers.
-        Dimensions::Vec2 => a.data_type() == DataType::F32 || (a.normalized() && a.data_type() != DataType::U32),
-        _ => a.data_type() == DataType::F32,
-    };
-    if !ok_type {
-        return Err(format!("component type {:?} is not supported here", a.data_type()));
-    }
-    let view = a.view().ok_or("has no buffer view")?;
-    let buffer = buffers.get(view.buffer().index()).ok_or("its buffer is missing")?;
-    let view_end = (view.offset() as u64).checked_add(view.length() as u64).ok_or("view overflows")?;
-    if view_end > buffer.0.len() as u64 {
-        return Err(format!("its view ends at byte {view_end}, past the buffer's {} bytes", buffer.0.len()));
-    }
-    let elem = a.size() as u64;
-    let stride = view.stride().map_or(elem, |s| s as u64);
-    if stride < elem {
-        return Err(format!("byte stride {stride} is smaller than an element ({elem} bytes)"));
-    }
-    if a.count() == 0 {
-        return Ok(());
-    }
-    let need = (a.offset() as u64)
-        .checked_add(stride.checked_mul(a.count() as u64 - 1).ok_or("count overflows")?)
-        .and_then(|x| x.checked_add(elem))
-        .ok_or("count overflows")?;
-    if need > view.length() as u64 {
-        return Err(format!("{} elements need {need} bytes, its view has {}", a.count(), view.length()));
     }
     Ok(())
 }

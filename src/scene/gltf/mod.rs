@@ -1,12 +1,15 @@
 //! glTF 2.0 import (.gltf and .glb) into a flat world-space `Scene`.
 
+mod accessor;
 mod describe;
+mod draco;
 mod extensions;
 mod glb;
 mod image;
 mod light;
 mod material;
 mod mesh;
+mod meshopt;
 mod resources;
 
 pub use describe::describe_file;
@@ -64,7 +67,7 @@ pub fn load_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
     let mut raw: serde_json::Value = serde_json::from_slice(json).map_err(|e| format!("invalid glTF JSON: {e}"))?;
     let mut warnings = Vec::new();
     check_extensions(&raw, &mut warnings)?;
-    normalise(&mut raw);
+    let fallbacks = normalise(&mut raw);
     let root: gltf::json::Root = serde_json::from_value(raw).map_err(|e| format!("invalid glTF JSON: {e}"))?;
     let document = contained(|| gltf::Document::from_json(root))?.map_err(|e| describe(&e))?;
     for buffer in document.buffers() {
@@ -74,7 +77,7 @@ pub fn load_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
     }
     let base = resources::Base(base);
     let buffers = resources::load_buffers(&document, blob, base)?;
-    let mut scene = from_document(&document, &buffers, base, &mut warnings)?;
+    let mut scene = from_document(&document, &buffers, base, &fallbacks, &mut warnings)?;
     scene.warnings = warnings;
     Ok(scene)
 }
@@ -85,16 +88,51 @@ pub fn load_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
 /// the crate's schema. `extensionsRequired` is dropped once `check_extensions` has accepted
 /// it: the crate's validator refuses every required extension outside its own feature list
 /// (KHR_materials_unlit among them), even the ones veach implements itself.
-fn normalise(raw: &mut serde_json::Value) {
+///
+/// A texture whose image comes from EXT_texture_webp or KHR_texture_basisu gets that image as
+/// its `source` (the crate knows neither extension and needs a source); its own `source`, the
+/// PNG/JPEG fallback, is returned as (preferred image, fallback image) to use when the
+/// preferred one cannot be decoded.
+fn normalise(raw: &mut serde_json::Value) -> Vec<(usize, usize)> {
     if let Some(root) = raw.as_object_mut() {
         root.remove("animations");
         root.remove("extensionsRequired");
+    }
+    let mut fallbacks = Vec::new();
+    if let Some(textures) = raw.get_mut("textures").and_then(|t| t.as_array_mut()) {
+        for texture in textures.iter_mut().filter_map(|t| t.as_object_mut()) {
+            let preferred = ["EXT_texture_webp", "KHR_texture_basisu"].iter().find_map(|e| {
+                texture.get("extensions").and_then(|x| x.get(e)).and_then(|x| x.get("source")).and_then(|s| s.as_u64())
+            });
+            if let Some(image) = preferred {
+                if let Some(fallback) = texture.get("source").and_then(|s| s.as_u64()) {
+                    fallbacks.push((image as usize, fallback as usize));
+                }
+                texture.insert("source".into(), serde_json::json!(image));
+            }
+        }
     }
     if let Some(scenes) = raw.get_mut("scenes").and_then(|s| s.as_array_mut()) {
         for scene in scenes.iter_mut().filter_map(|s| s.as_object_mut()) {
             scene.entry("nodes").or_insert_with(|| serde_json::json!([]));
         }
     }
+    // An accessor with neither a buffer view nor sparse values holds zeros (glTF allows it;
+    // Draco's accessors are all like this), but the crate's schema refuses it: it gets a
+    // sparse block of no values, which `accessor.rs` reads as zeros.
+    let has_views = raw.get("bufferViews").and_then(|v| v.as_array()).is_some_and(|v| !v.is_empty());
+    if has_views && let Some(accessors) = raw.get_mut("accessors").and_then(|a| a.as_array_mut()) {
+        for a in accessors.iter_mut().filter_map(|a| a.as_object_mut()) {
+            if !a.contains_key("bufferView") && !a.contains_key("sparse") {
+                a.insert(
+                    "sparse".into(),
+                    serde_json::json!({"count": 0, "indices": {"bufferView": 0, "componentType": 5125},
+                        "values": {"bufferView": 0}}),
+                );
+            }
+        }
+    }
+    fallbacks
 }
 
 thread_local! {
@@ -121,10 +159,51 @@ fn contained<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     result.map_err(|_| "invalid glTF: an index or reference is out of range".to_string())
 }
 
+/// Every node's world transform (its parents' chain, whether or not the scene draws it):
+/// skins place their joints with them.
+fn node_globals(doc: &gltf::Document) -> Result<Vec<Mat4>, String> {
+    let n = doc.nodes().len();
+    let mut parent = vec![None; n];
+    for node in doc.nodes() {
+        for child in node.children() {
+            if let Some(p) = parent.get_mut(child.index()) {
+                *p = Some(node.index());
+            }
+        }
+    }
+    let locals: Vec<Mat4> = doc.nodes().map(|node| Mat4::from_cols_array_2d(&node.transform().matrix())).collect();
+    let mut globals = vec![None; n];
+    for start in 0..n {
+        // Walk up to a node whose transform is known (or a root), then back down.
+        let mut chain = vec![start];
+        while let Some(p) = parent[*chain.last().unwrap_or(&start)] {
+            if globals[p].is_some() {
+                break;
+            }
+            if chain.len() > 256 {
+                return Err("node hierarchy deeper than 256 levels (a cycle?)".into());
+            }
+            chain.push(p);
+        }
+        let top = *chain.last().unwrap_or(&start);
+        let mut m = parent[top].and_then(|p| globals[p]).unwrap_or(Mat4::IDENTITY);
+        for &k in chain.iter().rev() {
+            if globals[k].is_none() {
+                m *= locals[k];
+                globals[k] = Some(m);
+            } else {
+                m = globals[k].unwrap_or(m);
+            }
+        }
+    }
+    Ok(globals.into_iter().map(|g| g.unwrap_or(Mat4::IDENTITY)).collect())
+}
+
 fn from_document(
     doc: &gltf::Document,
     buffers: &[gltf::buffer::Data],
     base: resources::Base,
+    fallbacks: &[(usize, usize)],
     warnings: &mut Vec<String>,
 ) -> Result<Scene, String> {
     let mut scene = Scene::default();
@@ -142,7 +221,19 @@ fn from_document(
                 image_slot[i] = Some(scene.textures.len() as u32);
                 scene.textures.push(texture);
             }
-            Err(e) => warnings.push(format!("image {i}: {e}; rendering without it")),
+            Err(e) => {
+                let fallback = fallbacks.iter().find(|f| f.0 == i).map(|f| f.1);
+                let what = if fallback.is_some() { "using its fallback image" } else { "rendering without it" };
+                warnings.push(format!("image {i}: {e}; {what}"));
+            }
+        }
+    }
+    // A WebP or Basis Universal image that did not decode gives way to its texture's fallback.
+    for &(preferred, fallback) in fallbacks {
+        if image_slot.get(preferred).is_some_and(Option::is_none)
+            && let Some(&Some(slot)) = image_slot.get(fallback)
+        {
+            image_slot[preferred] = Some(slot);
         }
     }
     for m in doc.materials() {
@@ -179,6 +270,9 @@ fn from_document(
             stack.extend(node.children().map(|c| (c, depth + 1)));
         }
     }
+    let views = accessor::Views::new(doc, buffers)?;
+    let globals = node_globals(doc)?;
+    let sources = mesh::MeshSources { doc, views: &views, globals: &globals };
     let mut stored: Vec<Option<u32>> = vec![None; uses.len()];
     let mut stack: Vec<(gltf::Node, Mat4, usize)> = gltf_scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     let mut visits = 0usize;
@@ -210,12 +304,15 @@ fn from_document(
             });
             let det = Mat3::from_mat4(world).determinant();
             let invertible = det.is_finite() && det.abs() > 1e-24 && world.inverse().is_finite();
-            if uses.get(mesh.index()).is_some_and(|&u| u >= 2) && !emits && invertible {
+            // A skin or the node's own morph weights make the node's geometry its own.
+            let shared = node.skin().is_none() && node.weights().is_none();
+            if uses.get(mesh.index()).is_some_and(|&u| u >= 2) && !emits && invertible && shared {
                 let id = match stored[mesh.index()] {
                     Some(id) => id,
                     None => {
                         let world_triangles = std::mem::take(&mut scene.triangles);
-                        let loaded = load_mesh(&mesh, Mat4::IDENTITY, buffers, default_material, &mut scene);
+                        let loaded =
+                            load_mesh(&mesh, Mat4::IDENTITY, Some(&node), &sources, default_material, &mut scene);
                         let object = std::mem::replace(&mut scene.triangles, world_triangles);
                         loaded?;
                         let name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
@@ -227,7 +324,7 @@ fn from_document(
                 };
                 scene.instances.push(super::Instance { mesh: id, transform: world });
             } else {
-                load_mesh(&mesh, world, buffers, default_material, &mut scene)?;
+                load_mesh(&mesh, world, Some(&node), &sources, default_material, &mut scene)?;
             }
         }
         if let Some(light) = node.light() {

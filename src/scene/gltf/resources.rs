@@ -89,6 +89,15 @@ pub fn load_buffers(doc: &gltf::Document, blob: Option<&[u8]>, base: Base) -> Re
         let i = buffer.index();
         let length = buffer.length() as u64;
         let fail = |e: String| format!("buffer {i}: {e}");
+        // A meshopt fallback buffer has no bytes: every view into it is stored compressed
+        // elsewhere (reading one that is not is refused by `accessor::Views`).
+        let fallback = ["EXT_meshopt_compression", "KHR_meshopt_compression"]
+            .iter()
+            .any(|e| buffer.extension_value(e).and_then(|v| v.get("fallback")).and_then(|f| f.as_bool()) == Some(true));
+        if fallback && matches!(buffer.source(), gltf::buffer::Source::Bin) {
+            out.push(gltf::buffer::Data(Vec::new()));
+            continue;
+        }
         let mut bytes = match buffer.source() {
             gltf::buffer::Source::Bin => blob.map(<[u8]>::to_vec).ok_or_else(|| fail("no GLB binary chunk".into()))?,
             gltf::buffer::Source::Uri(uri) => match data_uri(uri) {
