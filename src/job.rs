@@ -45,7 +45,7 @@ impl Job {
         }
         let (a, b) = (&self.settings, &other.settings);
         let bits = |c: Option<f32>| c.map(f32::to_bits);
-        let checks: [(&str, bool); 17] = [
+        let checks: [(&str, bool); 19] = [
             ("camera", a.camera == b.camera),
             ("image size", (a.width, a.height) == (b.width, b.height)),
             ("max depth", a.max_depth == b.max_depth),
@@ -63,6 +63,8 @@ impl Job {
             ("noise threshold", bits(a.noise_threshold) == bits(b.noise_threshold)),
             ("adaptive min samples", a.adaptive_min_samples() == b.adaptive_min_samples()),
             ("AOV layers", a.aovs == b.aovs),
+            ("glTF scene", a.scene == b.scene),
+            ("material variant", a.variant == b.variant),
         ];
         match checks.iter().find(|(_, same)| !same) {
             Some((what, _)) => Err(format!("the {what} differs")),

@@ -57,7 +57,7 @@ pub mod viewer;
 pub use error::Error;
 pub use film::Film;
 pub use job::{Job, Part, merge};
-pub use load::{Loaded, load, load_bytes};
+pub use load::{LoadOptions, Loaded, load, load_bytes, load_bytes_with, load_with};
 pub use packed::PackedScene;
 pub use render_loop::{Budget, CHUNK_SECONDS, Control, MAX_CHUNK, Progress, render_progressive};
 pub use renderer::{ROW_BAND, Renderer};

@@ -221,6 +221,12 @@ pub struct Settings {
     /// soon as one is asked for. Empty: none (the film has no AOV region).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub aovs: Vec<Aov>,
+    /// The glTF scene rendered, by index (None: the file's default scene).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scene: Option<usize>,
+    /// The KHR_materials_variants variant rendered, by name (None: the default materials).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variant: Option<String>,
 }
 
 impl Default for Settings {
@@ -245,6 +251,8 @@ impl Default for Settings {
             noise_threshold: None,
             min_samples: None,
             aovs: Vec::new(),
+            scene: None,
+            variant: None,
         }
     }
 }

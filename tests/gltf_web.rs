@@ -212,9 +212,13 @@ fn webp_and_basisu_textures_decode_to_the_png_s_pixels() {
 fn damaged_compressed_streams_are_refused_not_crashed() {
     let mut rng = common::rng::Lcg(99);
     let mut refused = 0;
-    for file in
-        ["cornell-box.meshopt.glb", "cornell-box.draco.glb", "cornell-box.gt-meshopt.glb", "box-textured.webp.glb"]
-    {
+    for file in [
+        "cornell-box.meshopt.glb",
+        "cornell-box.draco.glb",
+        "cornell-box.gt-meshopt.glb",
+        "box-textured.webp.glb",
+        "box-textured.ktx2.glb",
+    ] {
         let bytes = std::fs::read(web(file)).unwrap();
         for _ in 0..150 {
             let mut b = bytes.clone();
@@ -236,4 +240,78 @@ fn damaged_compressed_streams_are_refused_not_crashed() {
         }
     }
     assert!(refused > 50, "damage is noticed ({refused} refused)");
+}
+
+/// EXT_mesh_gpu_instancing becomes instances of the two-level BVH: PlayCanvas' sample draws
+/// one 12-triangle cube 125 times, stored once.
+#[test]
+fn gpu_instancing_draws_one_mesh_many_times() {
+    let Some(dir) = common::shared_models() else { return };
+    let loaded = veach::load(&dir.join("SimpleInstancing-playcanvas/simple-instancing.glb"), None).unwrap();
+    let scene = &loaded.scene;
+    assert_eq!(scene.instances.len(), 125);
+    assert_eq!(scene.meshes.len(), 1);
+    assert_eq!(scene.meshes[0].triangles.len(), 12);
+    // Every instance in its own place.
+    let mut origins: Vec<[i64; 3]> = scene
+        .instances
+        .iter()
+        .map(|i| i.transform.w_axis.truncate().to_array().map(|c| (c * 1000.0).round() as i64))
+        .collect();
+    origins.sort();
+    origins.dedup();
+    assert_eq!(origins.len(), 125);
+    let film = common::render(
+        &dir.join("SimpleInstancing-playcanvas/simple-instancing.glb"),
+        &Settings { width: 24, height: 24, ..Settings::default() },
+        2,
+        None,
+    );
+    assert_eq!(film.nonfinite_samples(), 0);
+}
+
+/// KHR_materials_variants: `--variant NAME` gives each primitive the material its mapping names
+/// for that variant; an unknown name is an error naming the file's variants. `--scene N`
+/// renders another scene of the file; one the file lacks is an error.
+#[test]
+fn variants_and_scenes_are_chosen_by_name_and_index() {
+    if let Some(dir) = common::shared_models() {
+        let path = dir.join("Variants-blenderio/18_variants.gltf");
+        let materials = |variant: Option<&str>| -> Vec<u32> {
+            let l = veach::load_with(&path, &veach::LoadOptions { variant, ..Default::default() }).unwrap();
+            let mut m: Vec<u32> = l.scene.triangles.iter().map(|t| t.material).collect();
+            m.sort();
+            m.dedup();
+            m
+        };
+        // Red (0), Orange (2), White (4) as Variant_Red; Blue (1), Green (3), White as Variant_Blue.
+        assert_eq!(materials(Some("Variant_Red")), [0, 2, 4]);
+        assert_eq!(materials(Some("Variant_Blue")), [1, 3, 4]);
+        let e = veach::load_with(&path, &veach::LoadOptions { variant: Some("Purple"), ..Default::default() });
+        let e = e.err().expect("unknown variant").to_string();
+        assert!(e.contains("Variant_Red, Variant_Blue") && !e.contains('\n'), "{e}");
+    }
+    // Two scenes built in code: scene 1 holds two triangles, the default scene 0 one.
+    let mut bin = Vec::new();
+    let (pa, pl) = push(&mut bin, &[0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+    let uri =
+        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
+    let doc = serde_json::to_vec(&json!({
+        "asset": {"version": "2.0"}, "scene": 0,
+        "scenes": [{"nodes": [0]}, {"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"mesh": 0, "translation": [2, 0, 0]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "buffers": [{"uri": uri, "byteLength": bin.len()}],
+        "bufferViews": [{"buffer": 0, "byteOffset": pa, "byteLength": pl}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
+    }))
+    .unwrap();
+    let count = |scene: Option<usize>| {
+        let l = veach::load_bytes_with(&doc, None, &veach::LoadOptions { scene, ..Default::default() });
+        l.map(|l| l.scene.triangles.len() + l.scene.instances.len())
+    };
+    assert_eq!(count(None).unwrap(), 1);
+    assert_eq!(count(Some(1)).unwrap(), 2);
+    let e = count(Some(2)).expect_err("no scene 2").to_string();
+    assert!(e.contains("no scene 2 (the file has 2)"), "{e}");
 }

@@ -229,6 +229,12 @@ pub struct LookArgs {
     /// Camera node name (default: the first camera, else a view framing the scene).
     #[arg(long)]
     pub camera: Option<String>,
+    /// The glTF scene to render, by index (default: the file's default scene).
+    #[arg(long, value_name = "N")]
+    pub scene: Option<usize>,
+    /// The KHR_materials_variants variant to render, by name (default: the default materials).
+    #[arg(long, value_name = "NAME")]
+    pub variant: Option<String>,
     /// Constant environment radiance R,G,B (default: the scene's extras.environment, else black).
     #[arg(long, value_parser = parse_rgb)]
     pub env_color: Option<Vec3>,
@@ -423,6 +429,8 @@ impl LookArgs {
     pub fn apply(&self, settings: &mut veach::Settings) {
         let absolute = |p: &std::path::Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
         settings.camera = self.camera.clone();
+        settings.scene = self.scene;
+        settings.variant = self.variant.clone();
         settings.env_map = self.env.as_deref().map(absolute);
         settings.env_color = self.env_color.map(Into::into);
         let defaults = veach::Settings::default();
@@ -436,6 +444,8 @@ impl LookArgs {
     /// --resume, which continues the saved render as it was).
     pub fn any(&self) -> bool {
         self.camera.is_some()
+            || self.scene.is_some()
+            || self.variant.is_some()
             || self.env_color.is_some()
             || self.env.is_some()
             || self.env_strength.is_some()

@@ -63,7 +63,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
         veach::output::check_writable(path)?;
     }
     let (job, resumed) = job_of(args)?;
-    let loaded = veach::load(&job.scene, job.settings.camera.as_deref())?;
+    let loaded = veach::load_with(&job.scene, &job.settings.load_options())?;
     crate::warn_all(&job.scene, &loaded.warnings);
     let triangles = loaded.scene.triangles.len();
     let packed = veach::PackedScene::new(&loaded.scene);

@@ -14,8 +14,6 @@ pub fn run(args: &StrategiesArgs) -> Result<(), Error> {
     if args.spp == 0 {
         return Err(Error::Input("--spp must be at least 1".into()));
     }
-    let loaded = veach::load(&args.scene, args.look.camera.as_deref())?;
-    crate::warn_all(&args.scene, &loaded.warnings);
     let (w, h) = (args.width, args.height);
     let mut settings = Settings {
         width: w,
@@ -26,6 +24,8 @@ pub fn run(args: &StrategiesArgs) -> Result<(), Error> {
         ..Settings::default()
     };
     args.look.apply(&mut settings);
+    let loaded = veach::load_with(&args.scene, &settings.load_options())?;
+    crate::warn_all(&args.scene, &loaded.warnings);
     let packed = veach::PackedScene::new(&loaded.scene);
     // One renderer for the four panels: only the estimator changes between them.
     let (mut renderer, _) = crate::open_renderer(packed, &loaded.camera, &settings, args.backend)?;

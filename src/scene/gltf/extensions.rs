@@ -21,11 +21,13 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_draco_mesh_compression",
     "EXT_texture_webp",
     "KHR_texture_basisu",
+    "KHR_materials_variants",
+    "EXT_mesh_gpu_instancing",
 ];
 
 /// Extensions veach knows and ignores for now; files that merely use them render, with one
 /// warning each.
-const KNOWN_UNIMPLEMENTED: &[&str] = &["KHR_materials_dispersion", "KHR_materials_variants"];
+const KNOWN_UNIMPLEMENTED: &[&str] = &["KHR_materials_dispersion"];
 
 /// Required extensions veach cannot honour are an error naming them; used ones it does not
 /// know get one warning each.

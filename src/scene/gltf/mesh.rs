@@ -14,6 +14,18 @@ pub struct MeshSources<'a> {
     pub doc: &'a gltf::Document,
     pub views: &'a Views<'a>,
     pub globals: &'a [Mat4],
+    /// The KHR_materials_variants variant chosen (None: the default materials).
+    pub variant: Option<usize>,
+}
+
+/// A primitive's material under a variant: the mapping that lists the variant, else its own.
+fn variant_material(prim: &gltf::Primitive, variant: Option<usize>) -> Option<usize> {
+    let v = variant?;
+    let mappings = prim.extension_value("KHR_materials_variants")?.get("mappings")?.as_array()?;
+    mappings.iter().find_map(|m| {
+        let listed = m.get("variants")?.as_array()?.iter().any(|x| x.as_u64() == Some(v as u64));
+        if listed { m.get("material")?.as_u64().map(|i| i as usize) } else { None }
+    })
 }
 
 /// A primitive's vertex data in the mesh's own space: morph targets applied (at the node's
@@ -231,7 +243,10 @@ pub fn load_mesh(
                 t.swap(1, 2);
             }
         }
-        let material = prim.material().index().map_or(default_material, |i| i as u32);
+        let material = variant_material(&prim, src.variant)
+            .filter(|&i| i < src.doc.materials().len())
+            .or_else(|| prim.material().index())
+            .map_or(default_material, |i| i as u32);
         // Tangent frames for what reads them: normal maps (the base's or the coat's) and anisotropy.
         let wants_tangents = scene
             .materials

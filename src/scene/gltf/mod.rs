@@ -35,7 +35,19 @@ pub const MAX_FILE_BYTES: u64 = 4 << 30;
 /// Most node visits while flattening the hierarchy (shared subtrees multiply).
 pub const MAX_NODE_VISITS: usize = 1 << 20;
 
+/// Which of a file's choices to load: a scene other than its default one, a material variant
+/// (KHR_materials_variants) other than the default materials.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Choice {
+    pub scene: Option<usize>,
+    pub variant: Option<String>,
+}
+
 pub fn load(path: &Path) -> Result<Scene, Error> {
+    load_with(path, &Choice::default())
+}
+
+pub fn load_with(path: &Path, choice: &Choice) -> Result<Scene, Error> {
     let fail = |msg: String| Error::Input(format!("{}: {msg}", path.display()));
     let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read: {e}")))?;
     if meta.is_dir() {
@@ -56,13 +68,17 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
     if bytes.len() as u64 > MAX_FILE_BYTES {
         return Err(fail(format!("larger than the {MAX_FILE_BYTES}-byte limit")));
     }
-    load_bytes(&bytes, path.parent()).map_err(fail)
+    load_bytes_with(&bytes, path.parent(), choice).map_err(fail)
 }
 
 /// Loads a .gltf or .glb held in memory; external files resolve against `base` (none: only
 /// embedded data, GLB chunks and data: URIs). Errors are the problem alone, without the file
 /// name.
 pub fn load_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
+    load_bytes_with(bytes, base, &Choice::default())
+}
+
+pub fn load_bytes_with(bytes: &[u8], base: Option<&Path>, choice: &Choice) -> Result<Scene, String> {
     let (json, blob) = if bytes.starts_with(b"glTF") { glb_chunks(bytes)? } else { (bytes, None) };
     let mut raw: serde_json::Value = serde_json::from_slice(json).map_err(|e| format!("invalid glTF JSON: {e}"))?;
     let mut warnings = Vec::new();
@@ -77,7 +93,7 @@ pub fn load_bytes(bytes: &[u8], base: Option<&Path>) -> Result<Scene, String> {
     }
     let base = resources::Base(base);
     let buffers = resources::load_buffers(&document, blob, base)?;
-    let mut scene = from_document(&document, &buffers, base, &fallbacks, &mut warnings)?;
+    let mut scene = from_document(&document, &buffers, base, &fallbacks, choice, &mut warnings)?;
     scene.warnings = warnings;
     Ok(scene)
 }
@@ -159,6 +175,61 @@ fn contained<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     result.map_err(|_| "invalid glTF: an index or reference is out of range".to_string())
 }
 
+/// The transforms a node draws its mesh with: its own, or with EXT_mesh_gpu_instancing one per
+/// instance (the node's transform times the instance's translation, rotation and scale).
+fn gpu_instances(
+    node: &gltf::Node,
+    doc: &gltf::Document,
+    views: &accessor::Views,
+    world: Mat4,
+) -> Result<Vec<Mat4>, String> {
+    let Some(attributes) = node.extension_value("EXT_mesh_gpu_instancing").and_then(|e| e.get("attributes")) else {
+        return Ok(vec![world]);
+    };
+    let fail = |e: String| format!("node {}: EXT_mesh_gpu_instancing: {e}", node.index());
+    let read = |name: &str, comps: usize| -> Result<Option<Vec<f32>>, String> {
+        let Some(i) = attributes.get(name).and_then(|v| v.as_u64()) else { return Ok(None) };
+        let a = doc.accessors().nth(i as usize).ok_or_else(|| fail(format!("no accessor {i}")))?;
+        accessor::read_floats(&a, views, comps).map(Some).map_err(|e| fail(format!("{name}: {e}")))
+    };
+    let (t, r, s) = (read("TRANSLATION", 3)?, read("ROTATION", 4)?, read("SCALE", 3)?);
+    let count = [t.as_ref().map(|v| v.len() / 3), r.as_ref().map(|v| v.len() / 4), s.as_ref().map(|v| v.len() / 3)];
+    let n = count.iter().flatten().copied().max().unwrap_or(0);
+    if count.iter().flatten().any(|&c| c != n) {
+        return Err(fail("its attributes have different counts".into()));
+    }
+    if n > MAX_NODE_VISITS {
+        return Err(fail(format!("{n} instances, above the limit of {MAX_NODE_VISITS}")));
+    }
+    Ok((0..n)
+        .map(|i| {
+            let translation = t.as_ref().map_or(glam::Vec3::ZERO, |v| glam::Vec3::from_slice(&v[3 * i..]));
+            let rotation = r.as_ref().map_or(glam::Quat::IDENTITY, |v| {
+                glam::Vec4::from_slice(&v[4 * i..]).try_normalize().map_or(glam::Quat::IDENTITY, glam::Quat::from_vec4)
+            });
+            let scale = s.as_ref().map_or(glam::Vec3::ONE, |v| glam::Vec3::from_slice(&v[3 * i..]));
+            world * Mat4::from_scale_rotation_translation(scale, rotation, translation)
+        })
+        .collect())
+}
+
+/// The index of the KHR_materials_variants variant named `name`.
+fn variant_index(doc: &gltf::Document, name: &str) -> Result<usize, String> {
+    let names: Vec<String> = doc
+        .extension_value("KHR_materials_variants")
+        .and_then(|v| v.get("variants"))
+        .and_then(|v| v.as_array())
+        .map(|a| a.iter().map(|v| v.get("name").and_then(|n| n.as_str()).unwrap_or("").to_string()).collect())
+        .unwrap_or_default();
+    names.iter().position(|n| n == name).ok_or_else(|| {
+        if names.is_empty() {
+            format!("no material variant '{name}': the file has none (KHR_materials_variants)")
+        } else {
+            format!("no material variant '{name}' (the file has: {})", names.join(", "))
+        }
+    })
+}
+
 /// Every node's world transform (its parents' chain, whether or not the scene draws it):
 /// skins place their joints with them.
 fn node_globals(doc: &gltf::Document) -> Result<Vec<Mat4>, String> {
@@ -204,6 +275,7 @@ fn from_document(
     buffers: &[gltf::buffer::Data],
     base: resources::Base,
     fallbacks: &[(usize, usize)],
+    choice: &Choice,
     warnings: &mut Vec<String>,
 ) -> Result<Scene, String> {
     let mut scene = Scene::default();
@@ -243,9 +315,16 @@ fn from_document(
     let default_material = scene.materials.len() as u32;
     scene.materials.push(Material::default());
 
-    let gltf_scene = doc.default_scene().or_else(|| doc.scenes().next());
-    let Some(gltf_scene) = gltf_scene else {
-        return Err("the file has no scene".into());
+    let gltf_scene = match choice.scene {
+        Some(k) => doc.scenes().nth(k).ok_or_else(|| format!("no scene {k} (the file has {})", doc.scenes().len()))?,
+        None => match doc.default_scene().or_else(|| doc.scenes().next()) {
+            Some(s) => s,
+            None => return Err("the file has no scene".into()),
+        },
+    };
+    let variant = match &choice.variant {
+        Some(name) => Some(variant_index(doc, name)?),
+        None => None,
     };
     if let Some(env) = environment_from_extras(gltf_scene.extras()) {
         scene.environment.radiance = env;
@@ -272,7 +351,7 @@ fn from_document(
     }
     let views = accessor::Views::new(doc, buffers)?;
     let globals = node_globals(doc)?;
-    let sources = mesh::MeshSources { doc, views: &views, globals: &globals };
+    let sources = mesh::MeshSources { doc, views: &views, globals: &globals, variant };
     let mut stored: Vec<Option<u32>> = vec![None; uses.len()];
     let mut stack: Vec<(gltf::Node, Mat4, usize)> = gltf_scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     let mut visits = 0usize;
@@ -302,29 +381,34 @@ fn from_document(
                 let m = p.material().index().map_or(default_material as usize, |i| i);
                 scene.materials.get(m).is_some_and(Material::is_emissive)
             });
-            let det = Mat3::from_mat4(world).determinant();
-            let invertible = det.is_finite() && det.abs() > 1e-24 && world.inverse().is_finite();
+            // EXT_mesh_gpu_instancing: the node draws its mesh once per instance transform.
+            let placements = gpu_instances(&node, doc, &views, world)?;
+            let many = placements.len() > 1 || uses.get(mesh.index()).is_some_and(|&u| u >= 2);
             // A skin or the node's own morph weights make the node's geometry its own.
             let shared = node.skin().is_none() && node.weights().is_none();
-            if uses.get(mesh.index()).is_some_and(|&u| u >= 2) && !emits && invertible && shared {
-                let id = match stored[mesh.index()] {
-                    Some(id) => id,
-                    None => {
-                        let world_triangles = std::mem::take(&mut scene.triangles);
-                        let loaded =
-                            load_mesh(&mesh, Mat4::IDENTITY, Some(&node), &sources, default_material, &mut scene);
-                        let object = std::mem::replace(&mut scene.triangles, world_triangles);
-                        loaded?;
-                        let name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
-                        scene.meshes.push(super::Mesh { name, triangles: object });
-                        let id = scene.meshes.len() as u32 - 1;
-                        stored[mesh.index()] = Some(id);
-                        id
-                    }
-                };
-                scene.instances.push(super::Instance { mesh: id, transform: world });
-            } else {
-                load_mesh(&mesh, world, Some(&node), &sources, default_material, &mut scene)?;
+            for world in placements {
+                let det = Mat3::from_mat4(world).determinant();
+                let invertible = det.is_finite() && det.abs() > 1e-24 && world.inverse().is_finite();
+                if many && !emits && invertible && shared {
+                    let id = match stored[mesh.index()] {
+                        Some(id) => id,
+                        None => {
+                            let world_triangles = std::mem::take(&mut scene.triangles);
+                            let loaded =
+                                load_mesh(&mesh, Mat4::IDENTITY, Some(&node), &sources, default_material, &mut scene);
+                            let object = std::mem::replace(&mut scene.triangles, world_triangles);
+                            loaded?;
+                            let name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
+                            scene.meshes.push(super::Mesh { name, triangles: object });
+                            let id = scene.meshes.len() as u32 - 1;
+                            stored[mesh.index()] = Some(id);
+                            id
+                        }
+                    };
+                    scene.instances.push(super::Instance { mesh: id, transform: world });
+                } else {
+                    load_mesh(&mesh, world, Some(&node), &sources, default_material, &mut scene)?;
+                }
             }
         }
         if let Some(light) = node.light() {
