@@ -63,6 +63,8 @@ const TRI_MIRRORED: u32 = 64u;
 // Bits 8–31: the triangle's emitter index + 1 in the light tree (0: not an emitter).
 const TRI_EMITTER_SHIFT: u32 = 8u;
 
+const PROJECTION_PERSPECTIVE: u32 = 0u;
+const PROJECTION_ORTHOGRAPHIC: u32 = 1u;
 const LIGHT_SAMPLER_POWER: u32 = 0u;
 const LIGHT_SAMPLER_TREE: u32 = 1u;
 // Light-tree nodes: rows per node, the leaf bit of the index word, the two-sided flag.
@@ -234,8 +236,10 @@ struct Params {
     sheen_base: u32,
     // First film row of the AOV region (aov.wgsl); 0: no AOVs.
     aov_base: u32,
+    // PROJECTION_PERSPECTIVE, or PROJECTION_ORTHOGRAPHIC (cam_right and cam_up then hold the
+    // view's half extents in scene units).
+    projection: u32,
     pad0: u32,
-    pad1: u32,
 }
 
 struct Ray {

@@ -72,8 +72,15 @@ pub struct Params {
     pub sheen_base: u32,
     /// First film row (vec4) of the AOV region (`src/aov.rs`); 0: no AOVs.
     pub aov_base: u32,
-    pub pad: [u32; 2],
+    /// PROJECTION_PERSPECTIVE, or PROJECTION_ORTHOGRAPHIC (then `cam_right` and `cam_up` are
+    /// the half extents of the view in scene units).
+    pub projection: u32,
+    pub pad: u32,
 }
+
+/// Camera projections (`Params::projection`; PROJECTION_* in shaders/common.wgsl).
+pub const PROJECTION_PERSPECTIVE: u32 = 0;
+pub const PROJECTION_ORTHOGRAPHIC: u32 = 1;
 
 /// Russian roulette starts once a path has this many segments.
 pub const RR_DEPTH: u32 = 3;
@@ -104,7 +111,8 @@ impl Params {
         let lights = if tree { scene.tree_emitters } else { light_count };
         let (w, h) = (settings.width, settings.height);
         let environment = scene.environment;
-        let tan_half = (0.5 * camera.yfov).tan();
+        // Half the view's height at distance 1 (perspective), or in scene units (orthographic).
+        let tan_half = camera.ortho.unwrap_or((0.5 * camera.yfov).tan());
         let aspect = w as f32 / h as f32;
         Params {
             cam_position: camera.position.into(),
@@ -151,7 +159,8 @@ impl Params {
             } else {
                 (settings.film_layout().aov_base(tile.width as usize * tile.height as usize) / 4) as u32
             },
-            pad: [0; 2],
+            projection: if camera.ortho.is_some() { PROJECTION_ORTHOGRAPHIC } else { PROJECTION_PERSPECTIVE },
+            pad: 0,
         }
     }
 }

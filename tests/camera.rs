@@ -84,3 +84,43 @@ fn the_first_camera_is_the_file_s_first_even_unnamed() {
     let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(names, ["camera0", "camera1"]);
 }
+
+/// An orthographic glTF camera (ymag 1, seen from z = 5 or z = 50) shows a lamp quad of
+/// half-size 0.5 at z = 0 over exactly the middle half of the image, whatever its distance.
+fn orthographic_lamp(ctx: Option<veach::gpu::GpuContext>) {
+    use common::build::{GltfBuilder, MeshData};
+    let engine = if ctx.is_some() { "gpu" } else { "cpu" };
+    for z in [5.0f32, 50.0] {
+        let dir = std::env::temp_dir().join(format!("veach-ortho-{}-{engine}-{z}", std::process::id()));
+        let mut b = GltfBuilder::new(&dir, "ortho");
+        let lamp = b.material(serde_json::json!({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]},
+            "emissiveFactor": [1, 1, 1]}));
+        let quad = b.mesh(&MeshData::quad(-0.5, -0.5, 0.5, 0.5, 0.0, MeshData::UPRIGHT), lamp);
+        b.node(serde_json::json!({"mesh": quad}));
+        b.orthographic_camera(1.0, 1.0, [0.0, 0.0, z]);
+        let path = b.write();
+        let loaded = veach::load(&path, None).unwrap();
+        assert_eq!(loaded.camera.ortho, Some(1.0));
+        let s = veach::Settings { width: 32, height: 32, env_color: Some([0.0; 3]), ..veach::Settings::default() };
+        let film = common::render(&path, &s, 4, ctx.clone());
+        for y in 0..32u32 {
+            for x in 0..32u32 {
+                let inside = (8..24).contains(&x) && (8..24).contains(&y);
+                let v = film.mean((y * 32 + x) as usize).x;
+                assert!((v - if inside { 1.0 } else { 0.0 }).abs() < 1e-5, "{engine} z {z}: pixel {x},{y} = {v}");
+            }
+        }
+    }
+}
+
+#[test]
+fn orthographic_cameras_see_parallel_rays() {
+    orthographic_lamp(None);
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn orthographic_cameras_see_parallel_rays_on_the_gpu() {
+    let Some(ctx) = common::gpu("orthographic_cameras_see_parallel_rays_on_the_gpu") else { return };
+    orthographic_lamp(Some(ctx));
+}

@@ -132,6 +132,7 @@ fn vr_gallery_shows_its_baked_lighting_unlit() {
         up: glam::Vec3::Y,
         right: glam::Vec3::X,
         yfov: 70f32.to_radians(),
+        ortho: None,
     };
     let render = |scene: &veach::Scene| {
         let s = Settings { width: 96, height: 64, env_color: Some([0.0; 3]), ..Settings::default() };

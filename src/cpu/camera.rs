@@ -3,7 +3,7 @@
 use super::bvh::Ray;
 use super::sampler::{Sampler, sample_2d, sampler_init};
 use super::sampling::sample_uniform_disk;
-use crate::params::Params;
+use crate::params::{PROJECTION_ORTHOGRAPHIC, Params};
 use glam::{UVec2, Vec2, Vec3};
 
 pub fn generate_ray(params: &Params, pixel: UVec2, u: Vec2, sampler: &mut Sampler) -> Ray {
@@ -12,6 +12,10 @@ pub fn generate_ray(params: &Params, pixel: UVec2, u: Vec2, sampler: &mut Sample
     let (forward, right, up) =
         (Vec3::from(params.cam_forward), Vec3::from(params.cam_right), Vec3::from(params.cam_up));
     let position = Vec3::from(params.cam_position);
+    // An orthographic camera's rays are parallel, from points across its view (no lens).
+    if params.projection == PROJECTION_ORTHOGRAPHIC {
+        return Ray { origin: position + x * right + y * up, dir: forward.normalize() };
+    }
     let dir = (forward + x * right + y * up).normalize();
     if params.aperture <= 0.0 {
         return Ray { origin: position, dir };

@@ -11,8 +11,11 @@ pub struct Camera {
     pub forward: Vec3,
     pub up: Vec3,
     pub right: Vec3,
-    /// Vertical field of view in radians.
+    /// Vertical field of view in radians (a perspective camera).
     pub yfov: f32,
+    /// An orthographic camera's half height of view in scene units (glTF's `ymag`); None: a
+    /// perspective camera.
+    pub ortho: Option<f32>,
 }
 
 impl Camera {
@@ -23,14 +26,20 @@ impl Camera {
         let up0 = m.y_axis.truncate();
         let right = forward.cross(up0).normalize_or(Vec3::X);
         let up = right.cross(forward);
-        Camera { name, position, forward, up, right, yfov }
+        Camera { name, position, forward, up, right, yfov, ortho: None }
+    }
+
+    /// An orthographic camera from a glTF node's world matrix and its half height `ymag`
+    /// (the width follows the image's aspect, as a perspective camera's does).
+    pub fn orthographic(name: String, m: Mat4, ymag: f32) -> Camera {
+        Camera { ortho: Some(ymag), ..Camera::from_matrix(name, m, 40f32.to_radians()) }
     }
 
     pub fn look_at(name: &str, position: Vec3, target: Vec3, up: Vec3, yfov: f32) -> Camera {
         let forward = (target - position).normalize_or(Vec3::NEG_Z);
         let right = forward.cross(up).normalize_or(Vec3::X);
         let up = right.cross(forward);
-        Camera { name: name.to_string(), position, forward, up, right, yfov }
+        Camera { name: name.to_string(), position, forward, up, right, yfov, ortho: None }
     }
 
     /// A default view: the bounding sphere seen from +Z, filling a 40° field of view.

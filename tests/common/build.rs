@@ -143,6 +143,15 @@ impl GltfBuilder {
         self.node(json!({"camera": cam, "translation": translation}))
     }
 
+    /// An orthographic camera of half extents `xmag` × `ymag`, looking down −z from `translation`.
+    pub fn orthographic_camera(&mut self, xmag: f32, ymag: f32, translation: [f32; 3]) -> usize {
+        let cam = self.push(
+            "cameras",
+            json!({"type": "orthographic", "orthographic": {"xmag": xmag, "ymag": ymag, "znear": 0.01, "zfar": 100}}),
+        );
+        self.node(json!({"camera": cam, "translation": translation}))
+    }
+
     pub fn light(&mut self, light: Value, node: Value) -> usize {
         self.use_extension("KHR_lights_punctual");
         if self.doc.pointer("/extensions/KHR_lights_punctual").is_none() {

@@ -369,11 +369,19 @@ fn from_document(
         if !world.is_finite() {
             return Err(format!("node {} has a non-finite transform", node.index()));
         }
-        if let Some(cam) = node.camera()
-            && let gltf::camera::Projection::Perspective(p) = cam.projection()
-        {
+        if let Some(cam) = node.camera() {
             let name = node.name().or(cam.name()).map(str::to_string).unwrap_or_default();
-            scene.cameras.push(Camera::from_matrix(name, world, p.yfov()));
+            let camera = match cam.projection() {
+                gltf::camera::Projection::Perspective(p) => Camera::from_matrix(name, world, p.yfov()),
+                gltf::camera::Projection::Orthographic(o) => {
+                    let ymag = o.ymag().abs();
+                    if !(ymag.is_finite() && ymag > 0.0) {
+                        return Err(format!("camera {}: orthographic ymag {} (expected > 0)", cam.index(), o.ymag()));
+                    }
+                    Camera::orthographic(name, world, ymag)
+                }
+            };
+            scene.cameras.push(camera);
             camera_nodes.push(node.index());
         }
         if let Some(mesh) = node.mesh() {
