@@ -24,6 +24,8 @@ override ANISOTROPY: bool = true;
 override IRIDESCENCE: bool = true;
 // The render accumulates AOVs (aov.wgsl); not a scene feature but a setting.
 override AOVS: bool = false;
+// Triangles carry COLOR_0 or TEXCOORD_1 (material.wgsl, triangle_uv and vertex_color).
+override VERTEX_EXTRAS: bool = true;
 
 struct BvhNode {
     min: vec3<f32>,
@@ -239,7 +241,8 @@ struct Params {
     // PROJECTION_PERSPECTIVE, or PROJECTION_ORTHOGRAPHIC (cam_right and cam_up then hold the
     // view's half extents in scene units).
     projection: u32,
-    pad0: u32,
+    // First record of the triangles' COLOR_0 and TEXCOORD_1 in the attributes (0: none).
+    extras_base: u32,
 }
 
 struct Ray {

@@ -90,7 +90,7 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>, aov: ptr<function, AovSa
         }
         let tri = world_triangle(hit.tri, hit.instance);
         let uv = triangle_uv(hit.tri, hit.u, hit.v);
-        var m = material_at(materials[tri.material], uv);
+        var m = material_at(materials[tri.material], uv, vertex_color(hit.tri, hit.u, hit.v));
         let point = tri.p0 + hit.u * tri.e1 + hit.v * tri.e2;
         let ng_cross = normalize(cross(tri.e1, tri.e2));
         let ng_raw = select(ng_cross, -ng_cross, (tri.flags & TRI_MIRRORED) != 0u);

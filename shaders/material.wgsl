@@ -8,18 +8,44 @@
 #include "texture.wgsl"
 #include "instance.wgsl"
 
-// TEXCOORD_0 at barycentrics (u, v) of vertices 1 and 2.
-fn triangle_uv(index: u32, u: f32, v: f32) -> vec2<f32> {
+// TEXCOORD_0 (xy) and TEXCOORD_1 (zw; 0 without it) at barycentrics (u, v) of vertices 1
+// and 2. A triangle's TEXCOORD_1 and COLOR_0 are an Attributes record of the region from
+// params.extras_base (src/packed/geometry.rs, pack_extras).
+fn triangle_uv(index: u32, u: f32, v: f32) -> vec4<f32> {
     let a = load_attributes(index);
-    return (1.0 - u - v) * a.uv0 + u * a.uv1 + v * a.uv2;
+    var uv1 = vec2<f32>(0.0);
+    if (VERTEX_EXTRAS) {
+        let e = load_attributes(params.extras_base + index);
+        uv1 = (1.0 - u - v) * e.uv0 + u * e.uv1 + v * e.uv2;
+    }
+    return vec4<f32>((1.0 - u - v) * a.uv0 + u * a.uv1 + v * a.uv2, uv1);
 }
 
-fn material_at(m: Material, uv: vec2<f32>) -> Material {
+// COLOR_0 at barycentrics (u, v) (white without it): per vertex two words of 16-bit unorm,
+// (r, g) and (b, a), in the record's normal and tangent words.
+fn vertex_color(index: u32, u: f32, v: f32) -> vec4<f32> {
+    if (!VERTEX_EXTRAS) {
+        return vec4<f32>(1.0);
+    }
+    let e = load_attributes(params.extras_base + index);
+    let c0 = vec4<f32>(unpack2x16unorm(e.n.x), unpack2x16unorm(e.n.y));
+    let c1 = vec4<f32>(unpack2x16unorm(e.n.z), unpack2x16unorm(e.t0));
+    let c2 = vec4<f32>(unpack2x16unorm(e.t12.x), unpack2x16unorm(e.t12.y));
+    return (1.0 - u - v) * c0 + u * c1 + v * c2;
+}
+
+// The material at a surface point: its factors times its textures at `uv` (both UV sets) and
+// the vertex colour `color` (COLOR_0 multiplies the base colour and alpha).
+fn material_at(m: Material, uv: vec4<f32>, color: vec4<f32>) -> Material {
     var r = m;
+    if (VERTEX_EXTRAS) {
+        r.base_color = m.base_color * color.xyz;
+        r.alpha = m.alpha * color.w;
+    }
     if (TEXTURES && m.base_color_texture.layer != NO_TEXTURE) {
         let c = sample_texture(m.base_color_texture, uv);
-        r.base_color = m.base_color * c.xyz;
-        r.alpha = m.alpha * c.w;
+        r.base_color = r.base_color * c.xyz;
+        r.alpha = r.alpha * c.w;
     }
     if (TEXTURES && m.metallic_roughness_texture.layer != NO_TEXTURE) {
         let c = sample_texture(m.metallic_roughness_texture, uv);
@@ -106,7 +132,7 @@ fn tangent_frame(tri: Triangle, index: u32, instance: u32, u: f32, v: f32, n: ve
 // tangents Gram-Schmidt'd against the shading normal n) turned by the texture's direction (RG
 // in [−1, 1]) and the rotation. Zero without tangents.
 fn anisotropy_direction(
-    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, n: vec3<f32>, m: Material, uv: vec2<f32>
+    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, n: vec3<f32>, m: Material, uv: vec4<f32>
 ) -> vec3<f32> {
     let f = tangent_frame(tri, index, instance, u, v, n);
     if (!f.found) {
@@ -133,6 +159,9 @@ fn alpha_passes(index: u32, u: f32, v: f32, ray: Ray) -> bool {
     if (TEXTURES && m.base_color_texture.layer != NO_TEXTURE) {
         alpha *= sample_texture(m.base_color_texture, triangle_uv(index, u, v)).w;
     }
+    if (VERTEX_EXTRAS) {
+        alpha *= vertex_color(index, u, v).w;
+    }
     if ((m.flags & MAT_ALPHA_MASK) != 0u) {
         return alpha >= m.alpha_cutoff;
     }
@@ -156,21 +185,21 @@ fn oct_decode(bits: u32) -> vec3<f32> {
 // Attributes are in object space: with instancing they move to world space here (normals by
 // the inverse transpose, tangents by the transform, handedness flipped by mirroring).
 fn shading_normal(
-    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec2<f32>
+    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec4<f32>
 ) -> vec3<f32> {
     return mapped_normal(tri, index, instance, u, v, ng, m.normal_texture, m.normal_scale, uv);
 }
 
 // The clearcoat's normal: its own normal map, else the interpolated normal.
 fn coat_normal(
-    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec2<f32>
+    tri: Triangle, index: u32, instance: u32, u: f32, v: f32, ng: vec3<f32>, m: Material, uv: vec4<f32>
 ) -> vec3<f32> {
     return mapped_normal(tri, index, instance, u, v, ng, m.clearcoat_normal_texture, m.clearcoat_normal_scale, uv);
 }
 
 fn mapped_normal(
     tri: Triangle, index: u32, instance: u32, u: f32, v: f32, ng: vec3<f32>, map: TextureRef, scale: f32,
-    uv: vec2<f32>
+    uv: vec4<f32>
 ) -> vec3<f32> {
     var n = ng;
     let a = load_attributes(index);

@@ -5,6 +5,8 @@
 
 const NO_TEXTURE: u32 = 0xffffffffu;
 const TEX_SRGB: u32 = 16u;
+// The texture reads TEXCOORD_1.
+const TEX_UV1: u32 = 32u;
 
 // Wrap modes: 0 repeat, 1 mirrored repeat, 2 clamp to edge.
 fn wrap_texel(i: i32, n: i32, mode: u32) -> i32 {
@@ -34,10 +36,11 @@ fn texel(t: TextureRef, x: i32, y: i32, n: i32) -> vec4<f32> {
     return c;
 }
 
-// The texture at uv (before the texture transform), linear RGB and alpha.
-fn sample_texture(t: TextureRef, uv: vec2<f32>) -> vec4<f32> {
+// The texture at uv (TEXCOORD_0 in xy, TEXCOORD_1 in zw: the texture reads its set), before
+// the texture transform; linear RGB and alpha.
+fn sample_texture(t: TextureRef, uv: vec4<f32>) -> vec4<f32> {
     let n = i32(textureDimensions(textures).x);
-    let uv1 = vec3<f32>(uv, 1.0);
+    let uv1 = vec3<f32>(select(uv.xy, uv.zw, (t.mode & TEX_UV1) != 0u), 1.0);
     var st = vec2<f32>(dot(t.row0, uv1), dot(t.row1, uv1));
     // Far-away UVs only lose precision; non-finite ones read texel 0.
     st = select(vec2<f32>(0.0), clamp(st, vec2<f32>(-1e6), vec2<f32>(1e6)), st == st);

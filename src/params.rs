@@ -75,7 +75,8 @@ pub struct Params {
     /// PROJECTION_PERSPECTIVE, or PROJECTION_ORTHOGRAPHIC (then `cam_right` and `cam_up` are
     /// the half extents of the view in scene units).
     pub projection: u32,
-    pub pad: u32,
+    /// First `attributes` record of the triangles' COLOR_0 and TEXCOORD_1 (0: none).
+    pub extras_base: u32,
 }
 
 /// Camera projections (`Params::projection`; PROJECTION_* in shaders/common.wgsl).
@@ -160,7 +161,7 @@ impl Params {
                 (settings.film_layout().aov_base(tile.width as usize * tile.height as usize) / 4) as u32
             },
             projection: if camera.ortho.is_some() { PROJECTION_ORTHOGRAPHIC } else { PROJECTION_PERSPECTIVE },
-            pad: 0,
+            extras_base: scene.extras_base,
         }
     }
 }

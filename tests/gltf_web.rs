@@ -315,3 +315,117 @@ fn variants_and_scenes_are_chosen_by_name_and_index() {
     let e = count(Some(2)).expect_err("no scene 2").to_string();
     assert!(e.contains("no scene 2 (the file has 2)"), "{e}");
 }
+
+/// A unit quad seen straight on by an orthographic camera filling the image, lit by a white
+/// sky, as a rough metal whose colour is COLOR_0 (red, green, blue, white at its corners) or a
+/// texture read through TEXCOORD_1 (TEXCOORD_0 all zero): the albedo AOV shows the colours
+/// where they are, on both engines.
+fn vertex_extras_scene(texture_on_uv1: bool) -> Vec<u8> {
+    let mut bin = Vec::new();
+    let (pa, pl) = push(&mut bin, &[-1.0f32, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, 1.0, 0.0]);
+    let (na, nl) = push(&mut bin, &[0.0f32, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0]);
+    let (ca, cl) = push(&mut bin, &[255u8, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255]);
+    let (u0a, u0l) = push(&mut bin, &[0.0f32; 8]);
+    let (u1a, u1l) = push(&mut bin, &[0.0f32, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0]);
+    let (ia, il) = push(&mut bin, &[0u16, 1, 2, 0, 2, 3]);
+    // An 8×8 PNG: the left half red, the right half green.
+    let img =
+        image::RgbaImage::from_fn(8, 8, |x, _| image::Rgba(if x < 4 { [255, 0, 0, 255] } else { [0, 255, 0, 255] }));
+    let mut png = Vec::new();
+    image::DynamicImage::ImageRgba8(img)
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    let png_uri = format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(&png));
+    let uri =
+        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
+    let mut attributes = json!({"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 3, "TEXCOORD_1": 4});
+    let mut pbr = json!({"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 1, "roughnessFactor": 0.5});
+    if texture_on_uv1 {
+        pbr["baseColorTexture"] = json!({"index": 0, "texCoord": 1});
+    } else {
+        attributes["COLOR_0"] = json!(2);
+    }
+    serde_json::to_vec(&json!({
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}],
+        "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}}],
+        "meshes": [{"primitives": [{"attributes": attributes, "indices": 5, "material": 0}]}],
+        "materials": [{"pbrMetallicRoughness": pbr}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"magFilter": 9728, "wrapS": 33071, "wrapT": 33071}],
+        "images": [{"uri": png_uri}],
+        "buffers": [{"uri": uri, "byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": pa, "byteLength": pl}, {"buffer": 0, "byteOffset": na, "byteLength": nl},
+            {"buffer": 0, "byteOffset": ca, "byteLength": cl}, {"buffer": 0, "byteOffset": u0a, "byteLength": u0l},
+            {"buffer": 0, "byteOffset": u1a, "byteLength": u1l}, {"buffer": 0, "byteOffset": ia, "byteLength": il},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5121, "normalized": true, "count": 4, "type": "VEC4"},
+            {"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 4, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 5, "componentType": 5123, "count": 6, "type": "SCALAR"},
+        ],
+    }))
+    .unwrap()
+}
+
+fn vertex_extras_on(ctx: Option<veach::gpu::GpuContext>) {
+    let engine = if ctx.is_some() { "gpu" } else { "cpu" };
+    let size = 16u32;
+    let settings = Settings {
+        width: size,
+        height: size,
+        env_color: Some([1.0; 3]),
+        aovs: vec![veach::aov::Aov::Albedo],
+        ..Settings::default()
+    };
+    for uv1 in [false, true] {
+        let loaded = veach::load_bytes(&vertex_extras_scene(uv1), None, None).unwrap();
+        let mut r =
+            common::renderer(veach::PackedScene::new(&loaded.scene), &loaded.camera, &settings, ctx.clone()).unwrap();
+        r.render_samples(0, 4).unwrap();
+        let albedo = r.film().unwrap().aov_image(veach::aov::Aov::Albedo).unwrap();
+        for y in 0..size {
+            for x in 0..size {
+                // The pixel centre in the quad's coordinates (x right, y up, −1..1).
+                let (px, py) = ((x as f32 + 0.5) / size as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / size as f32 * 2.0);
+                let got = Vec3::from_slice(&albedo[3 * (y * size + x) as usize..]);
+                let want = if uv1 {
+                    if px < 0.0 { Vec3::X } else { Vec3::Y }
+                } else {
+                    // Triangles (0, 1, 2) below the diagonal, (0, 2, 3) above; skip pixels on it.
+                    if (px - py).abs() < 0.2 {
+                        continue;
+                    }
+                    let (s, t) = ((px + 1.0) / 2.0, (py + 1.0) / 2.0);
+                    let (red, green, blue, white) = (Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE);
+                    if s > t {
+                        red * (1.0 - s) + green * (s - t) + blue * t
+                    } else {
+                        red * (1.0 - t) + blue * s + white * (t - s)
+                    }
+                };
+                let tol = if uv1 { 0.02 } else { 0.01 };
+                if uv1 && (px.abs() < 0.15) {
+                    continue; // the texture's bilinear edge between its halves
+                }
+                assert!((got - want).abs().max_element() < tol, "{engine} uv1 {uv1}: pixel {x},{y}: {got} vs {want}");
+            }
+        }
+    }
+}
+
+#[test]
+fn vertex_colors_and_second_uvs_reach_the_material() {
+    vertex_extras_on(None);
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn vertex_colors_and_second_uvs_reach_the_material_on_the_gpu() {
+    let Some(ctx) = common::gpu("vertex_colors_and_second_uvs_reach_the_material_on_the_gpu") else { return };
+    vertex_extras_on(Some(ctx));
+}

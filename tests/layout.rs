@@ -58,7 +58,6 @@ const RENAMED: &[(&str, &str, &str, u32)] = &[
     ("Attributes", "uv0", "uv", 0),
     ("Attributes", "uv1", "uv", 8),
     ("Attributes", "uv2", "uv", 16),
-    ("Params", "pad0", "pad", 0),
     ("Punctual", "pad0", "pad", 0),
     ("Punctual", "pad1", "pad", 4),
     ("Punctual", "pad2", "pad", 8),
@@ -123,7 +122,7 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
                 sheen_base,
                 aov_base,
                 projection,
-                pad
+                extras_base
             }),
         ),
         ("Triangle", rust_layout!(Triangle { p0, material, e1, light_pdf_area, e2, flags })),
@@ -273,6 +272,7 @@ fn shared_constants_have_the_same_values() {
         ("MAT_THIN_WALLED", p::MAT_THIN_WALLED as f64),
         ("NO_TEXTURE", p::NO_TEXTURE as f64),
         ("TEX_SRGB", p::TEX_SRGB as f64),
+        ("TEX_UV1", p::TEX_UV1 as f64),
         ("INSTANCE_MIRRORED", p::INSTANCE_MIRRORED as f64),
         ("PUNCTUAL_POINT", p::PUNCTUAL_POINT as f64),
         ("PUNCTUAL_SPOT", p::PUNCTUAL_SPOT as f64),
@@ -332,6 +332,7 @@ fn every_override_the_host_sets_exists_in_the_kernel() {
         anisotropy: true,
         iridescence: true,
         aovs: true,
+        vertex_extras: true,
     };
     for (entry, extra) in [(shaders::INTEGRATOR, None), (shaders::TRACE, Some("TRACE_KIND"))] {
         for geometry in [Geometry::Buffers, Geometry::Textures] {

@@ -8,7 +8,7 @@ use super::frame::{Frame, frame_from_normal, from_local, to_local};
 use super::instance::world_triangle;
 use super::light_tree::LightContext;
 use super::lights::{LightSample, light_pdf, sample_light, sample_punctual};
-use super::material::{anisotropy_direction, coat_normal, material_at, shading_normal, triangle_uv};
+use super::material::{anisotropy_direction, coat_normal, material_at, shading_normal, triangle_uv, vertex_color};
 use super::mis::mis_weight;
 use super::sampler::{Sampler, sample_1d, sample_2d};
 use crate::Strategy;
@@ -101,7 +101,8 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
         }
         let tri = &world_triangle(scene, hit.tri, hit.instance);
         let uv = triangle_uv(scene, hit.tri, hit.u, hit.v);
-        let mut mat = material_at(scene, &scene.materials[tri.material as usize], uv);
+        let color = vertex_color(scene, hit.tri, hit.u, hit.v);
+        let mut mat = material_at(scene, &scene.materials[tri.material as usize], uv, color);
         let m = &mat;
         let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
         let point = Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2;

@@ -8,19 +8,47 @@ use crate::packed::{
     MAT_ALPHA_MASK, Material, NO_TEXTURE, PackedScene, TRI_HAS_NORMALS, TRI_HAS_TANGENTS, TRI_MIRRORED,
     TRI_TANGENT_SIGN_SHIFT, TextureRef, Triangle, oct_decode,
 };
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
-pub fn triangle_uv(scene: &PackedScene, index: u32, u: f32, v: f32) -> Vec2 {
-    let a = &scene.attributes[index as usize];
-    (1.0 - u - v) * Vec2::from(a.uv[0]) + u * Vec2::from(a.uv[1]) + v * Vec2::from(a.uv[2])
+/// TEXCOORD_0 (xy) and TEXCOORD_1 (zw, 0 without it) at barycentrics (u, v) of vertices 1
+/// and 2. Twin of `triangle_uv`.
+pub fn triangle_uv(scene: &PackedScene, index: u32, u: f32, v: f32) -> Vec4 {
+    let at = |a: &crate::packed::Attributes| {
+        (1.0 - u - v) * Vec2::from(a.uv[0]) + u * Vec2::from(a.uv[1]) + v * Vec2::from(a.uv[2])
+    };
+    let uv0 = at(&scene.attributes[index as usize]);
+    let uv1 =
+        if scene.extras_base > 0 { at(&scene.attributes[(scene.extras_base + index) as usize]) } else { Vec2::ZERO };
+    Vec4::new(uv0.x, uv0.y, uv1.x, uv1.y)
 }
 
-pub fn material_at(scene: &PackedScene, m: &Material, uv: Vec2) -> Material {
+/// COLOR_0 at barycentrics (u, v) (white without it). Twin of `vertex_color`.
+pub fn vertex_color(scene: &PackedScene, index: u32, u: f32, v: f32) -> Vec4 {
+    if scene.extras_base == 0 {
+        return Vec4::ONE;
+    }
+    let e = &scene.attributes[(scene.extras_base + index) as usize];
+    let w = [e.n[0], e.n[1], e.n[2], e.t0, e.t12[0], e.t12[1]];
+    let unorm = |bits: u32| Vec2::new((bits & 0xffff) as f32 / 65535.0, (bits >> 16) as f32 / 65535.0);
+    let c = |k: usize| {
+        let (rg, ba) = (unorm(w[2 * k]), unorm(w[2 * k + 1]));
+        Vec4::new(rg.x, rg.y, ba.x, ba.y)
+    };
+    (1.0 - u - v) * c(0) + u * c(1) + v * c(2)
+}
+
+/// The material at a surface point: its factors times its textures at `uv` (both UV sets) and
+/// the vertex colour `color` (COLOR_0 multiplies the base colour and alpha).
+pub fn material_at(scene: &PackedScene, m: &Material, uv: Vec4, color: Vec4) -> Material {
     let mut r = *m;
+    if color != Vec4::ONE {
+        r.base_color = (Vec3::from(m.base_color) * color.truncate()).into();
+        r.alpha = m.alpha * color.w;
+    }
     if m.base_color_texture.layer != NO_TEXTURE {
         let c = sample_texture(scene, &m.base_color_texture, uv);
-        r.base_color = (Vec3::from(m.base_color) * c.truncate()).into();
-        r.alpha = m.alpha * c.w;
+        r.base_color = (Vec3::from(r.base_color) * c.truncate()).into();
+        r.alpha *= c.w;
     }
     if m.metallic_roughness_texture.layer != NO_TEXTURE {
         let c = sample_texture(scene, &m.metallic_roughness_texture, uv);
@@ -119,7 +147,7 @@ pub fn anisotropy_direction(
     v: f32,
     n: Vec3,
     m: &Material,
-    uv: Vec2,
+    uv: Vec4,
 ) -> Vec3 {
     let Some((t, b)) = tangent_frame(scene, tri, index, instance, u, v, n) else {
         return Vec3::ZERO;
@@ -142,6 +170,9 @@ pub fn alpha_passes(scene: &PackedScene, index: u32, u: f32, v: f32, ray: &Ray) 
     let mut alpha = m.alpha;
     if m.base_color_texture.layer != NO_TEXTURE {
         alpha *= sample_texture(scene, &m.base_color_texture, triangle_uv(scene, index, u, v)).w;
+    }
+    if scene.extras_base > 0 {
+        alpha *= vertex_color(scene, index, u, v).w;
     }
     if m.flags & MAT_ALPHA_MASK != 0 {
         return alpha >= m.alpha_cutoff;
@@ -169,7 +200,7 @@ pub fn shading_normal(
     v: f32,
     ng: Vec3,
     m: &Material,
-    uv: Vec2,
+    uv: Vec4,
 ) -> Vec3 {
     mapped_normal(scene, tri, index, instance, u, v, ng, &m.normal_texture, m.normal_scale, uv)
 }
@@ -185,7 +216,7 @@ pub fn coat_normal(
     v: f32,
     ng: Vec3,
     m: &Material,
-    uv: Vec2,
+    uv: Vec4,
 ) -> Vec3 {
     mapped_normal(scene, tri, index, instance, u, v, ng, &m.clearcoat_normal_texture, m.clearcoat_normal_scale, uv)
 }
@@ -201,7 +232,7 @@ pub fn mapped_normal(
     ng: Vec3,
     map: &TextureRef,
     scale: f32,
-    uv: Vec2,
+    uv: Vec4,
 ) -> Vec3 {
     let mut n = ng;
     let a = &scene.attributes[index as usize];

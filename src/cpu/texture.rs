@@ -1,6 +1,6 @@
 //! Twin of `shaders/texture.wgsl`: bilinear texture reads with glTF wrap modes.
 
-use crate::packed::{PackedScene, TEX_SRGB, TextureRef};
+use crate::packed::{PackedScene, TEX_SRGB, TEX_UV1, TextureRef};
 use glam::{Vec2, Vec3, Vec4};
 
 pub fn wrap_texel(i: i32, n: i32, mode: u32) -> i32 {
@@ -29,8 +29,11 @@ fn texel(scene: &PackedScene, t: &TextureRef, x: i32, y: i32, n: i32) -> Vec4 {
     }
 }
 
-pub fn sample_texture(scene: &PackedScene, t: &TextureRef, uv: Vec2) -> Vec4 {
+/// The texture at `uv` (TEXCOORD_0 in xy, TEXCOORD_1 in zw; the texture reads its set) before
+/// its transform.
+pub fn sample_texture(scene: &PackedScene, t: &TextureRef, uv: Vec4) -> Vec4 {
     let n = scene.texture_size as i32;
+    let uv = if t.mode & TEX_UV1 != 0 { Vec2::new(uv.z, uv.w) } else { Vec2::new(uv.x, uv.y) };
     let uv1 = uv.extend(1.0);
     let st = Vec2::new(Vec3::from(t.row0).dot(uv1), Vec3::from(t.row1).dot(uv1));
     let fix = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(-1e6, 1e6) };

@@ -19,11 +19,13 @@ pub struct Features {
     /// The render accumulates AOVs (a setting, not a property of the scene: false here, set
     /// by the engine).
     pub aovs: bool,
+    /// Triangles carry COLOR_0 or TEXCOORD_1.
+    pub vertex_extras: bool,
 }
 
 impl Features {
     /// The pipeline constants of `shaders/common.wgsl`.
-    pub fn constants(&self) -> [(&'static str, f64); 10] {
+    pub fn constants(&self) -> [(&'static str, f64); 11] {
         let f = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("ALPHA_TEST", f(self.alpha_test)),
@@ -36,6 +38,7 @@ impl Features {
             ("ANISOTROPY", f(self.anisotropy)),
             ("IRIDESCENCE", f(self.iridescence)),
             ("AOVS", f(self.aovs)),
+            ("VERTEX_EXTRAS", f(self.vertex_extras)),
         ]
     }
 }
@@ -74,6 +77,7 @@ impl PackedScene {
             anisotropy: self.materials.iter().any(|m| m.anisotropy > 0.0),
             iridescence: self.materials.iter().any(|m| m.iridescence > 0.0),
             aovs: false,
+            vertex_extras: self.extras_base > 0,
         }
     }
 }

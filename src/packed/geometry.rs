@@ -41,6 +41,23 @@ pub fn pack_triangle(scene: &Scene, t: &crate::scene::Triangle, light_pdf_area: 
     }
 }
 
+/// A triangle's extra vertex data (COLOR_0 and TEXCOORD_1), in an `Attributes` record of the
+/// region after the triangles' own (`extras_base`): per vertex two words of 16-bit unorm
+/// colour, (r, g) and (b, a), in the six normal and tangent words; TEXCOORD_1 in the UVs.
+/// White and zero where the triangle has none.
+pub fn pack_extras(t: &crate::scene::Triangle) -> Attributes {
+    let colors = t.colors.unwrap_or([glam::Vec4::ONE; 3]);
+    let unorm = |x: f32| (x.clamp(0.0, 1.0) * 65535.0).round() as u32;
+    let pair = |a: f32, b: f32| unorm(a) | unorm(b) << 16;
+    let w: Vec<u32> = colors.iter().flat_map(|c| [pair(c.x, c.y), pair(c.z, c.w)]).collect();
+    Attributes {
+        n: [w[0], w[1], w[2]],
+        t0: w[3],
+        t12: [w[4], w[5]],
+        uv: t.uvs1.unwrap_or([glam::Vec2::ZERO; 3]).map(|v| v.into()),
+    }
+}
+
 pub fn pack_attributes(t: &crate::scene::Triangle) -> Attributes {
     let tan = t.tangents.map(|v| oct_encode(v.truncate()));
     Attributes { n: t.normals.map(oct_encode), t0: tan[0], t12: [tan[1], tan[2]], uv: t.uvs.map(|v| v.into()) }

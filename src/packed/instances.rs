@@ -1,7 +1,7 @@
 //! The two-level scene: every stored mesh's CWBVH and triangles after the world mesh's, the
 //! instance records, and the top level over them (layout in `accel`).
 
-use super::geometry::{pack_attributes, pack_triangle};
+use super::geometry::{pack_attributes, pack_extras, pack_triangle};
 use super::layout::{Attributes, Triangle as PackedTriangle};
 use crate::accel::{self, BvhNode, CwNode, INSTANCE_MIRRORED, Instance, cw_slots, tlas::build_tlas, tlas::rows};
 use crate::scene::Scene;
@@ -17,6 +17,7 @@ pub fn build_instances(
     world_depth: u32,
     triangles: &mut Vec<PackedTriangle>,
     attributes: &mut Vec<Attributes>,
+    extras: &mut Vec<Attributes>,
     mut seconds: f64,
 ) -> (Vec<BvhNode>, u32, f64, usize, u32) {
     // Items: the world mesh (identity) when it has triangles, then every instance.
@@ -59,11 +60,13 @@ pub fn build_instances(
         if mesh.triangles.is_empty() {
             triangles.push(PackedTriangle::zeroed());
             attributes.push(Attributes::zeroed());
+            extras.push(Attributes::zeroed());
         }
         for &i in &bvh.order {
             let t = &mesh.triangles[i as usize];
             triangles.push(pack_triangle(scene, t, 0.0));
             attributes.push(pack_attributes(t));
+            extras.push(pack_extras(t));
         }
         mesh_roots.push(append_blas(&bvh.nodes, tri_offset, &mut blas_nodes));
     }

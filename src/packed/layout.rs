@@ -65,6 +65,8 @@ pub struct TextureRef {
 
 pub const NO_TEXTURE: u32 = u32::MAX;
 pub const TEX_SRGB: u32 = 16;
+/// The texture reads TEXCOORD_1.
+pub const TEX_UV1: u32 = 32;
 
 /// Material flags.
 pub const MAT_ALPHA_MASK: u32 = 1;

@@ -3,7 +3,7 @@
 
 use super::layout::{
     MAT_ALPHA_BLEND, MAT_ALPHA_MASK, MAT_DOUBLE_SIDED, MAT_THIN_WALLED, Material as PackedMaterial, NO_TEXTURE,
-    TEX_SRGB, TextureRef as PackedTextureRef,
+    TEX_SRGB, TEX_UV1, TextureRef as PackedTextureRef,
 };
 use crate::scene::{AlphaMode, Material, TextureRef};
 use glam::Vec3;
@@ -84,7 +84,10 @@ fn pack_texture_ref(t: Option<TextureRef>, srgb: bool) -> PackedTextureRef {
             row0: t.transform[0],
             layer: t.texture,
             row1: t.transform[1],
-            mode: t.wrap[0] as u32 | (t.wrap[1] as u32) << 2 | if srgb { TEX_SRGB } else { 0 },
+            mode: t.wrap[0] as u32
+                | (t.wrap[1] as u32) << 2
+                | if srgb { TEX_SRGB } else { 0 }
+                | if t.uv_set == 1 { TEX_UV1 } else { 0 },
         },
     }
 }

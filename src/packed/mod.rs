@@ -25,7 +25,7 @@ use crate::accel::{self, cw_slots};
 use crate::scene::{Environment, Scene};
 use bytemuck::Zeroable;
 use environment::pack_environment;
-use geometry::{pack_attributes, pack_triangle};
+use geometry::{pack_attributes, pack_extras, pack_triangle};
 use glam::Vec3;
 use instances::build_instances;
 use light_tree::{pack_light_tree, punctual_bounds, triangle_bounds};
@@ -52,6 +52,9 @@ pub struct PackedScene {
     pub instance_count: u32,
     pub triangles: Vec<Triangle>,
     pub attributes: Vec<Attributes>,
+    /// First record of the triangles' extra vertex data (COLOR_0, TEXCOORD_1) in
+    /// `attributes`, one a triangle in the same order (`geometry::pack_extras`); 0: none.
+    pub extras_base: u32,
     pub materials: Vec<Material>,
     pub lights: Vec<LightEntry>,
     /// The `lights` buffer: the alias table (one row per entry, `LightEntry` as u32 bits),
@@ -188,10 +191,34 @@ impl PackedScene {
         }
         let mut attributes: Vec<Attributes> = ordered.iter().map(|t| pack_attributes(t)).collect();
         attributes.resize(triangles.len(), Attributes::zeroed());
+        let mut extras: Vec<Attributes> = ordered.iter().map(|t| pack_extras(t)).collect();
+        extras.resize(triangles.len(), Attributes::zeroed());
         let (nodes, instance_base, build_seconds, bvh_nodes, bvh_depth) = if scene.instances.is_empty() {
             (cw_slots(&bvh.nodes), 0, bvh.build_seconds, bvh.nodes.len(), bvh.depth)
         } else {
-            build_instances(scene, bvh.nodes, bvh.depth, &mut triangles, &mut attributes, bvh.build_seconds)
+            build_instances(
+                scene,
+                bvh.nodes,
+                bvh.depth,
+                &mut triangles,
+                &mut attributes,
+                &mut extras,
+                bvh.build_seconds,
+            )
+        };
+        // Vertex colours and second UVs, only for scenes that have them: a region after the
+        // triangles' attributes (no new binding).
+        let has_extras = scene
+            .triangles
+            .iter()
+            .chain(scene.meshes.iter().flat_map(|m| &m.triangles))
+            .any(|t| t.colors.is_some() || t.uvs1.is_some());
+        let extras_base = if has_extras {
+            let base = attributes.len() as u32;
+            attributes.extend(extras);
+            base
+        } else {
+            0
         };
         let nodes_len = nodes.len();
         let (texels, texture_size, texture_layers) = pack_textures(&scene.textures);
@@ -207,6 +234,7 @@ impl PackedScene {
             },
             triangles,
             attributes,
+            extras_base,
             materials,
             lights,
             light_rows,

@@ -28,6 +28,10 @@ pub struct Triangle {
     /// all zero when the triangle has no tangent frame (no UVs or no normal map).
     pub tangents: [Vec4; 3],
     pub material: u32,
+    /// COLOR_0 per vertex (linear RGBA, multiplying the base color); None: white.
+    pub colors: Option<[Vec4; 3]>,
+    /// TEXCOORD_1 per vertex, read by textures that name it; None: the mesh has none.
+    pub uvs1: Option<[Vec2; 3]>,
 }
 
 impl Triangle {
@@ -55,6 +59,8 @@ pub enum Wrap {
 pub struct TextureRef {
     /// Index into `Scene::textures`.
     pub texture: u32,
+    /// The texture coordinate set it reads: 0 (TEXCOORD_0) or 1 (TEXCOORD_1).
+    pub uv_set: u32,
     /// Affine UV transform (KHR_texture_transform): uv' = (row0 · (u, v, 1), row1 · (u, v, 1)).
     pub transform: [[f32; 3]; 2],
     pub wrap: [Wrap; 2],

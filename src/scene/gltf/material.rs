@@ -29,8 +29,8 @@ pub fn convert_material(
     let mut texture = |info: Option<(gltf::texture::Texture, u32, Option<Transform>)>| {
         let (tex, tex_coord, transform) = info?;
         let slot = image_slot.get(tex.source().index()).copied().flatten()?;
-        if tex_coord != 0 {
-            warnings.push(format!("{name}: a texture reads TEXCOORD_{tex_coord}; veach reads TEXCOORD_0 only"));
+        if tex_coord > 1 {
+            warnings.push(format!("{name}: a texture reads TEXCOORD_{tex_coord}; veach reads TEXCOORD_0 and _1 only"));
         }
         let wrap = |w: gltf::texture::WrappingMode| match w {
             gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
@@ -40,6 +40,7 @@ pub fn convert_material(
         let sampler = tex.sampler();
         Some(TextureRef {
             texture: slot,
+            uv_set: (tex_coord == 1) as u32,
             transform: transform.map_or(TextureRef::IDENTITY, |(o, r, s)| uv_transform(o, r, s)),
             wrap: [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
         })

@@ -34,6 +34,8 @@ struct Vertices {
     positions: Vec<Vec3>,
     normals: Option<Vec<Vec3>>,
     uvs: Option<Vec<Vec2>>,
+    uvs1: Option<Vec<Vec2>>,
+    colors: Option<Vec<Vec4>>,
     tangents: Option<Vec<Vec4>>,
     indices: Vec<u32>,
     /// Per vertex, up to eight (joint, weight) influences (JOINTS_0/1, WEIGHTS_0/1).
@@ -75,6 +77,19 @@ fn read_vertices(
     let uvs: Option<Vec<Vec2>> = attr(Semantic::TexCoords(0), 2)?
         .filter(|v| same(v, 2))
         .map(|v| rows::<2>(v).into_iter().map(Vec2::from).collect());
+    let uvs1: Option<Vec<Vec2>> = attr(Semantic::TexCoords(1), 2)?
+        .filter(|v| same(v, 2))
+        .map(|v| rows::<2>(v).into_iter().map(Vec2::from).collect());
+    // COLOR_0: RGB or RGBA, floats or normalised integers.
+    let colors: Option<Vec<Vec4>> = match prim.get(&Semantic::Colors(0)).map(|a| a.dimensions().multiplicity()) {
+        Some(4) => attr(Semantic::Colors(0), 4)?
+            .filter(|v| same(v, 4))
+            .map(|v| rows::<4>(v).into_iter().map(Vec4::from).collect()),
+        Some(3) => attr(Semantic::Colors(0), 3)?
+            .filter(|v| same(v, 3))
+            .map(|v| rows::<3>(v).into_iter().map(|c| Vec3::from(c).extend(1.0)).collect()),
+        _ => None,
+    };
     let mut tangents: Option<Vec<Vec4>> =
         attr(Semantic::Tangents, 4)?.filter(|v| same(v, 4)).map(|v| rows::<4>(v).into_iter().map(Vec4::from).collect());
     let indices: Vec<u32> = match (&draco, prim.indices()) {
@@ -126,7 +141,7 @@ fn read_vertices(
             }
         }
     }
-    Ok(Some(Vertices { positions, normals, uvs, tangents, indices, skin }))
+    Ok(Some(Vertices { positions, normals, uvs, uvs1, colors, tangents, indices, skin }))
 }
 
 /// The joint matrices of a skin (each joint's world transform times its inverse bind
@@ -230,6 +245,7 @@ pub fn load_mesh(
                 .collect()
         });
         let uvs = v.uvs;
+        let (uvs1, colors) = (v.uvs1, v.colors);
         let mut tris = triangulate(&v.indices, mode);
         if scene.triangles.len() + tris.len() > MAX_TRIANGLES {
             return Err(format!("more than {MAX_TRIANGLES} triangles"));
@@ -299,7 +315,15 @@ pub fn load_mesh(
                 None => [Vec2::ZERO; 3],
             };
             let tangents = tangents.as_ref().map_or([Vec4::ZERO; 3], |t| idx.map(|i| t[i as usize]));
-            scene.triangles.push(Triangle { positions: p, normals: n, uvs: uv, tangents, material });
+            let finite2 = |v: Vec2| if v.is_finite() { v } else { Vec2::ZERO };
+            let uvs1 = uvs1.as_ref().map(|t| idx.map(|i| finite2(t[i as usize])));
+            let colors = colors.as_ref().map(|c| {
+                idx.map(|i| {
+                    let c = c[i as usize];
+                    if c.is_finite() { c.clamp(Vec4::ZERO, Vec4::ONE) } else { Vec4::ONE }
+                })
+            });
+            scene.triangles.push(Triangle { positions: p, normals: n, uvs: uv, tangents, material, colors, uvs1 });
         }
     }
     Ok(())
