@@ -86,10 +86,11 @@ struct Attributes {
     uv2: vec2<f32>,
 }
 
-// A material's texture: array layer (NO_TEXTURE: none), UV transform rows, wrap/sRGB bits.
+// A material's texture: its place in the atlas (page, x, y; NO_TEXTURE: none), UV transform
+// rows, wrap/sRGB/UV-set bits and the image's size (layout in src/packed/layout.rs).
 struct TextureRef {
     row0: vec3<f32>,
-    layer: u32,
+    atlas: u32,
     row1: vec3<f32>,
     mode: u32,
 }

@@ -128,7 +128,7 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>, aov: ptr<function, AovSa
         let wo = to_local(frame, -ray.dir);
         // A coat follows its own normal map, or the interpolated normal when the base's is mapped.
         if (CLEARCOAT && TEXTURES && m.clearcoat > 0.0
-            && (m.normal_texture.layer != NO_TEXTURE || m.clearcoat_normal_texture.layer != NO_TEXTURE)) {
+            && (m.normal_texture.atlas != NO_TEXTURE || m.clearcoat_normal_texture.atlas != NO_TEXTURE)) {
             var nc = coat_normal(tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, m, uv);
             nc = select(nc, -nc, dot(nc, ray.dir) > 0.0);
             m.coat_normal = to_local(frame, nc);

@@ -36,7 +36,7 @@ fn light_entry(slot: u32) -> LightEntry {
 
 // Emitted radiance at barycentrics `b` of triangle `index`.
 fn emitted(tri: Triangle, index: u32, b: vec2<f32>) -> vec3<f32> {
-    if (TEXTURES && materials[tri.material].emissive_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && materials[tri.material].emissive_texture.atlas != NO_TEXTURE) {
         // (COLOR_0 tints the base colour, not the emission.)
         return material_at(materials[tri.material], triangle_uv(index, b.x, b.y), vec4<f32>(1.0)).emission;
     }

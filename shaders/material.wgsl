@@ -42,53 +42,53 @@ fn material_at(m: Material, uv: vec4<f32>, color: vec4<f32>) -> Material {
         r.base_color = m.base_color * color.xyz;
         r.alpha = m.alpha * color.w;
     }
-    if (TEXTURES && m.base_color_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && m.base_color_texture.atlas != NO_TEXTURE) {
         let c = sample_texture(m.base_color_texture, uv);
         r.base_color = r.base_color * c.xyz;
         r.alpha = r.alpha * c.w;
     }
-    if (TEXTURES && m.metallic_roughness_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && m.metallic_roughness_texture.atlas != NO_TEXTURE) {
         let c = sample_texture(m.metallic_roughness_texture, uv);
         r.roughness = m.roughness * c.y;
         r.metallic = m.metallic * c.z;
     }
-    if (TEXTURES && m.emissive_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && m.emissive_texture.atlas != NO_TEXTURE) {
         r.emission = m.emission * sample_texture(m.emissive_texture, uv).xyz;
     }
-    if (TEXTURES && TRANSMISSION && m.transmission_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && TRANSMISSION && m.transmission_texture.atlas != NO_TEXTURE) {
         r.transmission = m.transmission * sample_texture(m.transmission_texture, uv).x;
     }
-    if (TEXTURES && (m.specular_texture.layer != NO_TEXTURE || m.specular_color_texture.layer != NO_TEXTURE)) {
+    if (TEXTURES && (m.specular_texture.atlas != NO_TEXTURE || m.specular_color_texture.atlas != NO_TEXTURE)) {
         var factor = m.dielectric_f90;
         var f0 = m.specular_f0;
-        if (m.specular_texture.layer != NO_TEXTURE) {
+        if (m.specular_texture.atlas != NO_TEXTURE) {
             factor *= sample_texture(m.specular_texture, uv).w;
         }
-        if (m.specular_color_texture.layer != NO_TEXTURE) {
+        if (m.specular_color_texture.atlas != NO_TEXTURE) {
             f0 *= sample_texture(m.specular_color_texture, uv).xyz;
         }
         r.dielectric_f0 = min(f0, vec3<f32>(1.0)) * factor;
         r.dielectric_f90 = factor;
     }
-    if (TEXTURES && CLEARCOAT && m.clearcoat_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && CLEARCOAT && m.clearcoat_texture.atlas != NO_TEXTURE) {
         r.clearcoat = m.clearcoat * sample_texture(m.clearcoat_texture, uv).x;
     }
-    if (TEXTURES && CLEARCOAT && m.clearcoat_roughness_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && CLEARCOAT && m.clearcoat_roughness_texture.atlas != NO_TEXTURE) {
         r.clearcoat_roughness = m.clearcoat_roughness * sample_texture(m.clearcoat_roughness_texture, uv).y;
     }
-    if (TEXTURES && SHEEN && m.sheen_color_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && SHEEN && m.sheen_color_texture.atlas != NO_TEXTURE) {
         r.sheen_color = m.sheen_color * sample_texture(m.sheen_color_texture, uv).xyz;
     }
-    if (TEXTURES && SHEEN && m.sheen_roughness_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && SHEEN && m.sheen_roughness_texture.atlas != NO_TEXTURE) {
         r.sheen_roughness = m.sheen_roughness * sample_texture(m.sheen_roughness_texture, uv).w;
     }
-    if (TEXTURES && ANISOTROPY && m.anisotropy_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && ANISOTROPY && m.anisotropy_texture.atlas != NO_TEXTURE) {
         r.anisotropy = m.anisotropy * sample_texture(m.anisotropy_texture, uv).z;
     }
-    if (TEXTURES && IRIDESCENCE && m.iridescence_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && IRIDESCENCE && m.iridescence_texture.atlas != NO_TEXTURE) {
         r.iridescence = m.iridescence * sample_texture(m.iridescence_texture, uv).x;
     }
-    if (TEXTURES && IRIDESCENCE && m.iridescence_thickness_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && IRIDESCENCE && m.iridescence_thickness_texture.atlas != NO_TEXTURE) {
         let t = sample_texture(m.iridescence_thickness_texture, uv).y;
         r.iridescence_thickness_max = mix(m.iridescence_thickness_min, m.iridescence_thickness_max, t);
     }
@@ -139,7 +139,7 @@ fn anisotropy_direction(
         return vec3<f32>(0.0);
     }
     var d = vec2<f32>(1.0, 0.0);
-    if (TEXTURES && m.anisotropy_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && m.anisotropy_texture.atlas != NO_TEXTURE) {
         let e = sample_texture(m.anisotropy_texture, uv).xy * 2.0 - 1.0;
         if (dot(e, e) > 1e-8) {
             d = normalize(e);
@@ -156,7 +156,7 @@ fn alpha_passes(index: u32, u: f32, v: f32, ray: Ray) -> bool {
     let tri = load_triangle(index);
     let m = materials[tri.material];
     var alpha = m.alpha;
-    if (TEXTURES && m.base_color_texture.layer != NO_TEXTURE) {
+    if (TEXTURES && m.base_color_texture.atlas != NO_TEXTURE) {
         alpha *= sample_texture(m.base_color_texture, triangle_uv(index, u, v)).w;
     }
     if (VERTEX_EXTRAS) {
@@ -215,7 +215,7 @@ fn mapped_normal(
         let len2 = dot(s, s);
         n = select(ng, s * inverseSqrt(len2), len2 > 0.0);
     }
-    if (!TEXTURES || map.layer == NO_TEXTURE) {
+    if (!TEXTURES || map.atlas == NO_TEXTURE) {
         return n;
     }
     let f = tangent_frame(tri, index, instance, u, v, n);

@@ -18,18 +18,21 @@ use veach::packed::{Material as PackedMaterial, pack_material};
 use veach::scene::Material;
 
 fn material(base: f32, metallic: f32, roughness: f32, specular: f32) -> PackedMaterial {
-    pack_material(&Material {
-        base_color: Vec3::new(base, base * 0.8, base * 0.6),
-        metallic,
-        roughness,
-        specular_factor: specular,
-        ..Material::default()
-    })
+    pack_material(
+        &Material {
+            base_color: Vec3::new(base, base * 0.8, base * 0.6),
+            metallic,
+            roughness,
+            specular_factor: specular,
+            ..Material::default()
+        },
+        &[],
+    )
 }
 
 /// A coat of strength 1 and this roughness over `base`, its normal tilted by `tilt` (radians).
 fn coated(base: Material, roughness: f32, tilt: f32) -> PackedMaterial {
-    let mut m = pack_material(&Material { clearcoat: 1.0, clearcoat_roughness: roughness, ..base });
+    let mut m = pack_material(&Material { clearcoat: 1.0, clearcoat_roughness: roughness, ..base }, &[]);
     m.coat_normal = [tilt.sin(), 0.3 * tilt.sin(), tilt.cos()];
     m.coat_normal = Vec3::from(m.coat_normal).normalize().into();
     m
@@ -44,18 +47,24 @@ fn plastic(base: f32, roughness: f32) -> Material {
 }
 
 fn thin(roughness: f32, transmission: f32) -> PackedMaterial {
-    pack_material(&Material {
-        base_color: Vec3::new(1.0, 0.9, 0.8),
-        metallic: 0.0,
-        roughness,
-        transmission,
-        thin_walled: true,
-        ..Material::default()
-    })
+    pack_material(
+        &Material {
+            base_color: Vec3::new(1.0, 0.9, 0.8),
+            metallic: 0.0,
+            roughness,
+            transmission,
+            thin_walled: true,
+            ..Material::default()
+        },
+        &[],
+    )
 }
 
 fn glass(roughness: f32, transmission: f32) -> PackedMaterial {
-    pack_material(&Material { base_color: Vec3::ONE, metallic: 0.0, roughness, transmission, ..Material::default() })
+    pack_material(
+        &Material { base_color: Vec3::ONE, metallic: 0.0, roughness, transmission, ..Material::default() },
+        &[],
+    )
 }
 
 /// (name, material, η seen from wo).
@@ -78,17 +87,17 @@ fn cases() -> Vec<(String, PackedMaterial, f32)> {
         ("aniso metal s=0.8 r=0.4", Material { metallic: 1.0, ..plastic(0.9, 0.4) }, 0.8, [0.6, 0.8]),
         ("aniso plastic s=0.5 r=0.3", plastic(0.5, 0.3), 0.5, [1.0, 0.0]),
     ] {
-        let mut m = pack_material(&Material { anisotropy: strength, ..base });
+        let mut m = pack_material(&Material { anisotropy: strength, ..base }, &[]);
         m.anisotropy_tangent = tangent;
         v.push((name.to_string(), m, 1.5));
     }
     // KHR_materials_iridescence: a film over plastic and over metal.
     let film =
         |base: Material| Material { iridescence: 1.0, iridescence_ior: 1.3, iridescence_thickness_max: 350.0, ..base };
-    v.push(("iridescent plastic r=0.4".to_string(), pack_material(&film(plastic(0.5, 0.4))), 1.5));
+    v.push(("iridescent plastic r=0.4".to_string(), pack_material(&film(plastic(0.5, 0.4)), &[]), 1.5));
     v.push((
         "iridescent metal r=0.3".to_string(),
-        pack_material(&film(Material { metallic: 1.0, ..plastic(0.9, 0.3) })),
+        pack_material(&film(Material { metallic: 1.0, ..plastic(0.9, 0.3) }), &[]),
         1.5,
     ));
     // Thin walls (no volume): seen from either side the sheet has air behind it (η = ior).
@@ -102,10 +111,14 @@ fn cases() -> Vec<(String, PackedMaterial, f32)> {
     ));
     v.push((
         "sheen r=0.5 over lambert".to_string(),
-        pack_material(&sheened(plastic(0.8, 1.0), Vec3::new(1.0, 0.7, 0.5), 0.5)),
+        pack_material(&sheened(plastic(0.8, 1.0), Vec3::new(1.0, 0.7, 0.5), 0.5), &[]),
         1.5,
     ));
-    v.push(("sheen r=0.15 over plastic".to_string(), pack_material(&sheened(plastic(0.5, 0.5), Vec3::ONE, 0.15)), 1.5));
+    v.push((
+        "sheen r=0.15 over plastic".to_string(),
+        pack_material(&sheened(plastic(0.5, 0.5), Vec3::ONE, 0.15), &[]),
+        1.5,
+    ));
     v.push((
         "coat r=0.4 over sheen r=0.8".to_string(),
         coated(sheened(plastic(0.6, 0.7), Vec3::splat(0.8), 0.8), 0.4, 0.1),
@@ -295,7 +308,7 @@ fn white_furnaces_of_the_layers_lose_only_what_their_model_explains() {
             );
         }
         for roughness in [0.1f32, 0.4, 1.0] {
-            let m = pack_material(&sheened(lambert, Vec3::ONE, roughness));
+            let m = pack_material(&sheened(lambert, Vec3::ONE, roughness), &[]);
             let energy = quad(&|wi| bsdf_eval(&m, wo, wi, 1.5).y as f64);
             let e_max = (0..=100).map(|i| sheen_albedo(i as f32 / 100.0, roughness)).fold(0.0f32, f32::max) as f64;
             let loss_bound = e_max - sheen_albedo(wo.z, roughness) as f64;
@@ -370,7 +383,7 @@ fn a_smooth_thin_wall_passes_light_straight_through() {
 #[test]
 fn anisotropy_stretches_the_lobe_along_its_direction() {
     let base = Material { metallic: 1.0, ..plastic(0.9, 0.3) };
-    let mut m = pack_material(&Material { anisotropy: 0.9, ..base });
+    let mut m = pack_material(&Material { anisotropy: 0.9, ..base }, &[]);
     let phi = 0.7f32;
     m.anisotropy_tangent = [phi.cos(), phi.sin()];
     let wo = Vec3::Z;

@@ -608,3 +608,26 @@ fn adaptive_renders_report_their_samples_resume_exactly_and_refuse_to_merge() {
     args.extend(["--min-samples", "8"]);
     assert_user_error(&veach(&args, &[]), "noise-threshold");
 }
+
+/// `--stats-json` and `veach info` report the texture atlas: the box's 211² logo is kept at
+/// its size on one 256² page.
+#[test]
+fn texture_memory_is_reported() {
+    let d = temp_dir("texture-stats");
+    let scene = common::root().join("tests/data/web/box-textured.webp.glb");
+    let (out, stats) = (d.join("box.png"), d.join("stats.json"));
+    let (out_s, stats_s) = (out.to_str().unwrap(), stats.to_str().unwrap());
+    let args = ["render", scene.to_str().unwrap(), "-o", out_s, "--width", "16", "--height", "16", "--spp", "1"];
+    let r = veach(&[&args[..], &["--backend", "cpu", "--stats-json", stats_s]].concat(), &[]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!((s["texture_pages"].as_u64(), s["texture_page_side"].as_u64()), (Some(1), Some(256)), "{s}");
+    assert_eq!(s["texture_bytes"].as_u64(), Some(256 * 256 * 4));
+    assert_eq!(s["textures_shrunk"].as_u64(), Some(0));
+    let occupancy = s["texture_occupancy"].as_f64().unwrap();
+    assert!((occupancy - 211.0 * 211.0 / 65536.0).abs() < 1e-9, "{occupancy}");
+    let info = veach(&["info", scene.to_str().unwrap()], &[]);
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(text.contains("texture atlas: 1 page(s) of 256²"), "{text}");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -127,7 +127,7 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
         ),
         ("Triangle", rust_layout!(Triangle { p0, material, e1, light_pdf_area, e2, flags })),
         ("Attributes", rust_layout!(Attributes { n, t0, t12, uv })),
-        ("TextureRef", rust_layout!(TextureRef { row0, layer, row1, mode })),
+        ("TextureRef", rust_layout!(TextureRef { row0, atlas, row1, mode })),
         (
             "Material",
             rust_layout!(Material {
@@ -273,6 +273,12 @@ fn shared_constants_have_the_same_values() {
         ("NO_TEXTURE", p::NO_TEXTURE as f64),
         ("TEX_SRGB", p::TEX_SRGB as f64),
         ("TEX_UV1", p::TEX_UV1 as f64),
+        ("TEX_PAGE_SHIFT", p::TEX_PAGE_SHIFT as f64),
+        ("TEX_X_SHIFT", p::TEX_X_SHIFT as f64),
+        ("TEX_COORD_MASK", p::TEX_COORD_MASK as f64),
+        ("TEX_WIDTH_SHIFT", p::TEX_WIDTH_SHIFT as f64),
+        ("TEX_HEIGHT_SHIFT", p::TEX_HEIGHT_SHIFT as f64),
+        ("TEX_SIZE_MASK", p::TEX_SIZE_MASK as f64),
         ("INSTANCE_MIRRORED", p::INSTANCE_MIRRORED as f64),
         ("PUNCTUAL_POINT", p::PUNCTUAL_POINT as f64),
         ("PUNCTUAL_SPOT", p::PUNCTUAL_SPOT as f64),

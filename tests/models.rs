@@ -184,7 +184,7 @@ fn specular_glossiness_spheres_match_their_metal_rough_twins() {
         assert_eq!(by_name(sg).emission, by_name(mr).emission, "{sg} vs {mr}");
         assert_eq!(by_name(sg).emissive_texture.is_some(), by_name(mr).emissive_texture.is_some(), "{sg} vs {mr}");
     }
-    let plain = veach::packed::pack_material(by_name("SpecGloss"));
+    let plain = veach::packed::pack_material(by_name("SpecGloss"), &[]);
     assert_eq!((plain.metallic, plain.roughness), (0.0, 1.0));
     assert_eq!(plain.dielectric_f0, [1.0; 3], "F0 is the specular factor");
     assert_eq!(plain.base_color, [1.0; 3]);

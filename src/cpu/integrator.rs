@@ -148,7 +148,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
         let wo = to_local(&frame, -ray.dir);
         // A coat follows its own normal map, or the interpolated normal when the base's is mapped.
         if mat.clearcoat > 0.0
-            && (mat.normal_texture.layer != NO_TEXTURE || mat.clearcoat_normal_texture.layer != NO_TEXTURE)
+            && (mat.normal_texture.atlas != NO_TEXTURE || mat.clearcoat_normal_texture.atlas != NO_TEXTURE)
         {
             let mut nc = coat_normal(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, &mat, uv);
             if nc.dot(ray.dir) > 0.0 {

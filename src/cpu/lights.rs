@@ -130,7 +130,7 @@ pub fn sample_light(scene: &PackedScene, params: &Params, ctx: &LightContext, u:
 /// Emitted radiance at barycentrics `b` of triangle `index`.
 fn emitted(scene: &PackedScene, tri: &Triangle, index: u32, b: Vec2) -> Vec3 {
     let m = &scene.materials[tri.material as usize];
-    if m.emissive_texture.layer != NO_TEXTURE {
+    if m.emissive_texture.atlas != NO_TEXTURE {
         // (COLOR_0 tints the base colour, not the emission.)
         material_at(scene, m, triangle_uv(scene, index, b.x, b.y), glam::Vec4::ONE).emission.into()
     } else {

@@ -45,54 +45,54 @@ pub fn material_at(scene: &PackedScene, m: &Material, uv: Vec4, color: Vec4) -> 
         r.base_color = (Vec3::from(m.base_color) * color.truncate()).into();
         r.alpha = m.alpha * color.w;
     }
-    if m.base_color_texture.layer != NO_TEXTURE {
+    if m.base_color_texture.atlas != NO_TEXTURE {
         let c = sample_texture(scene, &m.base_color_texture, uv);
         r.base_color = (Vec3::from(r.base_color) * c.truncate()).into();
         r.alpha *= c.w;
     }
-    if m.metallic_roughness_texture.layer != NO_TEXTURE {
+    if m.metallic_roughness_texture.atlas != NO_TEXTURE {
         let c = sample_texture(scene, &m.metallic_roughness_texture, uv);
         r.roughness = m.roughness * c.y;
         r.metallic = m.metallic * c.z;
     }
-    if m.emissive_texture.layer != NO_TEXTURE {
+    if m.emissive_texture.atlas != NO_TEXTURE {
         r.emission = (Vec3::from(m.emission) * sample_texture(scene, &m.emissive_texture, uv).truncate()).into();
     }
-    if m.transmission_texture.layer != NO_TEXTURE {
+    if m.transmission_texture.atlas != NO_TEXTURE {
         r.transmission = m.transmission * sample_texture(scene, &m.transmission_texture, uv).x;
     }
-    if m.specular_texture.layer != NO_TEXTURE || m.specular_color_texture.layer != NO_TEXTURE {
+    if m.specular_texture.atlas != NO_TEXTURE || m.specular_color_texture.atlas != NO_TEXTURE {
         let mut factor = m.dielectric_f90;
         let mut f0 = Vec3::from(m.specular_f0);
-        if m.specular_texture.layer != NO_TEXTURE {
+        if m.specular_texture.atlas != NO_TEXTURE {
             factor *= sample_texture(scene, &m.specular_texture, uv).w;
         }
-        if m.specular_color_texture.layer != NO_TEXTURE {
+        if m.specular_color_texture.atlas != NO_TEXTURE {
             f0 *= sample_texture(scene, &m.specular_color_texture, uv).truncate();
         }
         r.dielectric_f0 = (f0.min(Vec3::ONE) * factor).into();
         r.dielectric_f90 = factor;
     }
-    if m.clearcoat_texture.layer != NO_TEXTURE {
+    if m.clearcoat_texture.atlas != NO_TEXTURE {
         r.clearcoat = m.clearcoat * sample_texture(scene, &m.clearcoat_texture, uv).x;
     }
-    if m.clearcoat_roughness_texture.layer != NO_TEXTURE {
+    if m.clearcoat_roughness_texture.atlas != NO_TEXTURE {
         r.clearcoat_roughness = m.clearcoat_roughness * sample_texture(scene, &m.clearcoat_roughness_texture, uv).y;
     }
-    if m.sheen_color_texture.layer != NO_TEXTURE {
+    if m.sheen_color_texture.atlas != NO_TEXTURE {
         r.sheen_color =
             (Vec3::from(m.sheen_color) * sample_texture(scene, &m.sheen_color_texture, uv).truncate()).into();
     }
-    if m.sheen_roughness_texture.layer != NO_TEXTURE {
+    if m.sheen_roughness_texture.atlas != NO_TEXTURE {
         r.sheen_roughness = m.sheen_roughness * sample_texture(scene, &m.sheen_roughness_texture, uv).w;
     }
-    if m.anisotropy_texture.layer != NO_TEXTURE {
+    if m.anisotropy_texture.atlas != NO_TEXTURE {
         r.anisotropy = m.anisotropy * sample_texture(scene, &m.anisotropy_texture, uv).z;
     }
-    if m.iridescence_texture.layer != NO_TEXTURE {
+    if m.iridescence_texture.atlas != NO_TEXTURE {
         r.iridescence = m.iridescence * sample_texture(scene, &m.iridescence_texture, uv).x;
     }
-    if m.iridescence_thickness_texture.layer != NO_TEXTURE {
+    if m.iridescence_thickness_texture.atlas != NO_TEXTURE {
         let t = sample_texture(scene, &m.iridescence_thickness_texture, uv).y;
         r.iridescence_thickness_max =
             m.iridescence_thickness_min + (m.iridescence_thickness_max - m.iridescence_thickness_min) * t;
@@ -153,7 +153,7 @@ pub fn anisotropy_direction(
         return Vec3::ZERO;
     };
     let mut d = Vec2::X;
-    if m.anisotropy_texture.layer != NO_TEXTURE {
+    if m.anisotropy_texture.atlas != NO_TEXTURE {
         let c = sample_texture(scene, &m.anisotropy_texture, uv);
         let e = Vec2::new(c.x, c.y) * 2.0 - Vec2::ONE;
         if e.dot(e) > 1e-8 {
@@ -168,7 +168,7 @@ pub fn alpha_passes(scene: &PackedScene, index: u32, u: f32, v: f32, ray: &Ray) 
     let tri = &scene.triangles[index as usize];
     let m = &scene.materials[tri.material as usize];
     let mut alpha = m.alpha;
-    if m.base_color_texture.layer != NO_TEXTURE {
+    if m.base_color_texture.atlas != NO_TEXTURE {
         alpha *= sample_texture(scene, &m.base_color_texture, triangle_uv(scene, index, u, v)).w;
     }
     if scene.extras_base > 0 {
@@ -245,7 +245,7 @@ pub fn mapped_normal(
         let len2 = s.dot(s);
         n = if len2 > 0.0 { s / len2.sqrt() } else { ng };
     }
-    if map.layer == NO_TEXTURE {
+    if map.atlas == NO_TEXTURE {
         return n;
     }
     let Some((t, b)) = tangent_frame(scene, tri, index, instance, u, v, n) else {

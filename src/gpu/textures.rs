@@ -1,17 +1,17 @@
-//! The scene's images on the device: one texture array of square RGBA8 layers.
+//! The scene's images on the device: the texture atlas's pages as one texture array (RGBA8).
 
 use super::GpuContext;
 use crate::Error;
 use crate::packed::PackedScene;
 use wgpu::util::DeviceExt;
 
-/// The scene's images as one texture array (RGBA8, one square layer per image).
+/// The texture atlas as one texture array (RGBA8, one square layer per page).
 pub fn texture_array(ctx: &GpuContext, scene: &PackedScene) -> Result<(wgpu::TextureView, u64), Error> {
     let limits = ctx.device.limits();
-    let (side, layers) = (scene.texture_size, scene.texture_layers);
+    let (side, layers) = (scene.texture_size, scene.texture_pages);
     if side > limits.max_texture_dimension_2d || layers > limits.max_texture_array_layers {
         return Err(Error::Limit(format!(
-            "{layers} textures of {side}² texels exceed the device's texture arrays \
+            "{layers} texture pages of {side}² texels exceed the device's texture arrays \
              (max_texture_dimension_2d = {}, max_texture_array_layers = {})",
             limits.max_texture_dimension_2d, limits.max_texture_array_layers
         )));

@@ -64,7 +64,7 @@ impl PackedScene {
                 m.iridescence_thickness_texture,
             ]
             .iter()
-            .any(|t| t.layer != NO_TEXTURE)
+            .any(|t| t.atlas != NO_TEXTURE)
         };
         Features {
             alpha_test: self.triangles.iter().any(|t| t.flags & TRI_ALPHA != 0),

@@ -52,13 +52,15 @@ pub struct Attributes {
     pub uv: [[f32; 2]; 3],
 }
 
-/// A material's texture: layer of the texture array (NO_TEXTURE: none), UV transform rows,
-/// and mode bits (wrap s in bits 0–1, wrap t in 2–3, sRGB-encoded in bit 4).
+/// A material's texture: where the image sits in the texture atlas (page in bits 24–31, x in
+/// 12–23, y in 0–11; NO_TEXTURE: none), UV transform rows, and mode bits (wrap s in bits 0–1,
+/// wrap t in 2–3, sRGB-encoded in bit 4, TEXCOORD_1 in bit 5, width − 1 in 6–18, height − 1
+/// in 19–31).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct TextureRef {
     pub row0: [f32; 3],
-    pub layer: u32,
+    pub atlas: u32,
     pub row1: [f32; 3],
     pub mode: u32,
 }
@@ -67,6 +69,15 @@ pub const NO_TEXTURE: u32 = u32::MAX;
 pub const TEX_SRGB: u32 = 16;
 /// The texture reads TEXCOORD_1.
 pub const TEX_UV1: u32 = 32;
+/// The atlas word: page << TEX_PAGE_SHIFT | x << TEX_X_SHIFT | y, x and y within TEX_COORD_MASK.
+pub const TEX_PAGE_SHIFT: u32 = 24;
+pub const TEX_X_SHIFT: u32 = 12;
+pub const TEX_COORD_MASK: u32 = 0xfff;
+/// The image's size in the mode word: (width − 1) << TEX_WIDTH_SHIFT | (height − 1) <<
+/// TEX_HEIGHT_SHIFT, each within TEX_SIZE_MASK.
+pub const TEX_WIDTH_SHIFT: u32 = 6;
+pub const TEX_HEIGHT_SHIFT: u32 = 19;
+pub const TEX_SIZE_MASK: u32 = 0x1fff;
 
 /// Material flags.
 pub const MAT_ALPHA_MASK: u32 = 1;

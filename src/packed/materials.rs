@@ -3,8 +3,9 @@
 
 use super::layout::{
     MAT_ALPHA_BLEND, MAT_ALPHA_MASK, MAT_DOUBLE_SIDED, MAT_THIN_WALLED, Material as PackedMaterial, NO_TEXTURE,
-    TEX_SRGB, TEX_UV1, TextureRef as PackedTextureRef,
+    TEX_HEIGHT_SHIFT, TEX_PAGE_SHIFT, TEX_SRGB, TEX_UV1, TEX_WIDTH_SHIFT, TEX_X_SHIFT, TextureRef as PackedTextureRef,
 };
+use super::textures::Placement;
 use crate::scene::{AlphaMode, Material, TextureRef};
 use glam::Vec3;
 
@@ -12,7 +13,9 @@ pub fn luminance(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }
 
-pub fn pack_material(m: &Material) -> PackedMaterial {
+/// `m` as the kernels read it; `atlas` places each of the scene's textures.
+pub fn pack_material(m: &Material, atlas: &[Placement]) -> PackedMaterial {
+    let pack_texture_ref = |t: Option<TextureRef>, srgb: bool| pack_texture_ref(t, srgb, atlas);
     let (cutoff, mut flags) = match m.alpha_mode {
         AlphaMode::Opaque => (0.0, 0),
         AlphaMode::Mask(c) => (c, MAT_ALPHA_MASK),
@@ -77,18 +80,21 @@ pub fn pack_material(m: &Material) -> PackedMaterial {
     }
 }
 
-fn pack_texture_ref(t: Option<TextureRef>, srgb: bool) -> PackedTextureRef {
-    match t {
-        None => PackedTextureRef { row0: [1.0, 0.0, 0.0], layer: NO_TEXTURE, row1: [0.0, 1.0, 0.0], mode: 0 },
-        Some(t) => PackedTextureRef {
-            row0: t.transform[0],
-            layer: t.texture,
-            row1: t.transform[1],
-            mode: t.wrap[0] as u32
-                | (t.wrap[1] as u32) << 2
-                | if srgb { TEX_SRGB } else { 0 }
-                | if t.uv_set == 1 { TEX_UV1 } else { 0 },
-        },
+fn pack_texture_ref(t: Option<TextureRef>, srgb: bool, atlas: &[Placement]) -> PackedTextureRef {
+    let none = PackedTextureRef { row0: [1.0, 0.0, 0.0], atlas: NO_TEXTURE, row1: [0.0, 1.0, 0.0], mode: 0 };
+    let Some((t, p)) = t.and_then(|t| Some((t, atlas.get(t.texture as usize)?))) else {
+        return none;
+    };
+    PackedTextureRef {
+        row0: t.transform[0],
+        atlas: p.page << TEX_PAGE_SHIFT | p.x << TEX_X_SHIFT | p.y,
+        row1: t.transform[1],
+        mode: t.wrap[0] as u32
+            | (t.wrap[1] as u32) << 2
+            | if srgb { TEX_SRGB } else { 0 }
+            | if t.uv_set == 1 { TEX_UV1 } else { 0 }
+            | (p.width - 1) << TEX_WIDTH_SHIFT
+            | (p.height - 1) << TEX_HEIGHT_SHIFT,
     }
 }
 

@@ -19,7 +19,10 @@ pub use features::Features;
 pub use layout::*;
 pub use materials::{dielectric_f0, luminance, pack_material};
 pub use octahedral::{oct_decode, oct_encode};
-pub use textures::{MAX_TEXTURE_LAYER_SIDE, TEXTURE_BUDGET_BYTES, texture_layer_side};
+pub use textures::{
+    MAX_PAGE_SIDE, MAX_PAGES, Placement, TEXTURE_BUDGET_BYTES, TextureAtlas, pack_textures, pack_textures_within,
+    shelf_pack,
+};
 
 use crate::accel::{self, cw_slots};
 use crate::scene::{Environment, Scene};
@@ -38,7 +41,6 @@ pub fn pack_light_tree_for_bench(emitters: &[crate::accel::light_bvh::LightBound
     (t.nodes, t.depth, t0.elapsed().as_secs_f64(), t.rows.len() * 16)
 }
 use lights::{build_alias_table, pack_punctual};
-use textures::pack_textures;
 
 #[derive(Clone)]
 pub struct PackedScene {
@@ -95,11 +97,16 @@ pub struct PackedScene {
     /// First row of the sheen albedo table (after the punctual lights) in `light_data`.
     pub sheen_base: u32,
     pub punctual_count: u32,
-    /// Texture array: `texture_layers` square layers of `texture_size`² RGBA8 texels (one
-    /// u32 each, R in the low byte), row-major, layer after layer. At least one layer.
+    /// The texture atlas: `texture_pages` square pages of `texture_size`² RGBA8 texels (one
+    /// u32 each, R in the low byte), row-major, page after page; at least one page. Each
+    /// image keeps its own size (see `textures::pack_textures`).
     pub texels: Vec<u32>,
     pub texture_size: u32,
-    pub texture_layers: u32,
+    pub texture_pages: u32,
+    /// Texels the images cover over those of the pages.
+    pub texture_occupancy: f64,
+    /// What packing changed that the user should hear of (images stored smaller), one line each.
+    pub warnings: Vec<String>,
     pub env_width: u32,
     pub env_height: u32,
     /// Σ luminance × sin θ over all texels: the normaliser of the sampling pmf.
@@ -122,7 +129,8 @@ impl PackedScene {
         let bvh = accel::build(&verts);
         let ordered: Vec<&crate::scene::Triangle> = bvh.order.iter().map(|&i| &scene.triangles[i as usize]).collect();
 
-        let materials: Vec<Material> = scene.materials.iter().map(pack_material).collect();
+        let atlas = pack_textures(&scene.textures);
+        let materials: Vec<Material> = scene.materials.iter().map(|m| pack_material(m, &atlas.placements)).collect();
 
         // Lights: emissive triangles with positive area, chosen proportional to power.
         let mut light_tris = Vec::new();
@@ -221,7 +229,6 @@ impl PackedScene {
             0
         };
         let nodes_len = nodes.len();
-        let (texels, texture_size, texture_layers) = pack_textures(&scene.textures);
         let bounds = scene.bounds();
         let extent = if bounds.is_empty() { 1.0 } else { bounds.diagonal().length() };
         let mut packed = PackedScene {
@@ -257,9 +264,11 @@ impl PackedScene {
             punctual_base: 0,
             sheen_base: 0,
             punctual_count: scene.punctual_lights.len() as u32,
-            texels,
-            texture_size,
-            texture_layers,
+            texture_occupancy: atlas.occupancy(),
+            texels: atlas.texels,
+            texture_size: atlas.side,
+            texture_pages: atlas.pages,
+            warnings: atlas.warnings,
             env_width: 0,
             env_height: 0,
             env_total: 0.0,

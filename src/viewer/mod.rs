@@ -296,6 +296,9 @@ impl Viewer {
             self.home = self.orbit.clone();
         }
         let packed = PackedScene::new(&scene);
+        for w in &packed.warnings {
+            self.status = if self.status.is_empty() { w.clone() } else { format!("{}; {w}", self.status) };
+        }
         // The first restart installs `environment()`: the renderer alone cannot tell a sky
         // made black on purpose from none.
         self.env_applied = None;

@@ -6,6 +6,22 @@ use veach::Error;
 pub fn run(scene: Option<&Path>) -> Result<(), Error> {
     if let Some(path) = scene {
         println!("{}", veach::scene::gltf::describe_file(path)?);
+        let loaded = veach::load(path, None)?;
+        if !loaded.scene.textures.is_empty() {
+            let atlas = veach::packed::pack_textures(&loaded.scene.textures);
+            let images: u64 = loaded.scene.textures.iter().map(|t| t.width as u64 * t.height as u64 * 4).sum();
+            println!(
+                "  texture atlas: {} page(s) of {}², {:.1} MiB ({:.1} MiB of images, {:.0} % of the pages used)",
+                atlas.pages,
+                atlas.side,
+                atlas.bytes() as f64 / 1048576.0,
+                images as f64 / 1048576.0,
+                100.0 * atlas.occupancy()
+            );
+            for w in &atlas.warnings {
+                println!("  {w}");
+            }
+        }
         return Ok(());
     }
     let adapters = veach::gpu::adapters();

@@ -67,6 +67,14 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     crate::warn_all(&job.scene, &loaded.warnings);
     let triangles = loaded.scene.triangles.len();
     let packed = veach::PackedScene::new(&loaded.scene);
+    crate::warn_all(&job.scene, &packed.warnings);
+    let textures = serde_json::json!({
+        "texture_bytes": packed.texels.len() as u64 * 4,
+        "texture_pages": packed.texture_pages,
+        "texture_page_side": packed.texture_size,
+        "texture_occupancy": packed.texture_occupancy,
+        "textures_shrunk": packed.warnings.len(),
+    });
     let (bvh_nodes, bvh_depth, bvh_seconds) = (packed.bvh_nodes, packed.bvh_depth, packed.bvh_build_seconds);
     let light_tree = (packed.light_tree_nodes, packed.light_tree_depth, packed.light_tree_seconds);
     let (mut renderer, backend_reason) = crate::open_renderer(packed, &loaded.camera, &job.settings, args.backend)?;
@@ -270,8 +278,10 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             "denoise_engine": args.denoise.then_some(denoise_engine),
             "denoise_seconds": denoise_seconds,
         });
-        if let (Some(all), serde_json::Value::Object(more)) = (stats.as_object_mut(), denoise) {
-            all.extend(more);
+        for more in [denoise, textures] {
+            if let (Some(all), serde_json::Value::Object(more)) = (stats.as_object_mut(), more) {
+                all.extend(more);
+            }
         }
         veach::output::write_atomic(path, serde_json::to_string_pretty(&stats).unwrap_or_default().as_bytes())?;
     }

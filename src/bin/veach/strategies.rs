@@ -27,6 +27,7 @@ pub fn run(args: &StrategiesArgs) -> Result<(), Error> {
     let loaded = veach::load_with(&args.scene, &settings.load_options())?;
     crate::warn_all(&args.scene, &loaded.warnings);
     let packed = veach::PackedScene::new(&loaded.scene);
+    crate::warn_all(&args.scene, &packed.warnings);
     // One renderer for the four panels: only the estimator changes between them.
     let (mut renderer, _) = crate::open_renderer(packed, &loaded.camera, &settings, args.backend)?;
     let mut sheet = image::RgbImage::new(4 * w, h + LABEL_BAR);
