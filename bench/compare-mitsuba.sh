@@ -26,6 +26,10 @@
 #                       equal time: veach records --reference series, Mitsuba renders 1, 2, 4,
 #                       ... spp (each timed warm), and the report interpolates both to the same
 #                       times; plots go to OUT_DIR/convergence_SCENE.png (veach plot-convergence)
+#   --equal-time TIMES  only Mitsuba llvm's clamped RMSE at these render times (e.g. "1 4 16")
+#                       on bench/adaptive.sh's scenes and references (Cornell box d8 256²,
+#                       glass Cornell box d8 64², Veach d2 256²), one "scene seconds rmse" line
+#                       each; bench/adaptive.sh --mitsuba sets it and prints the ratios
 #   --out-dir DIR       where the images and stats go (default: a temp dir, removed unless --rmse)
 #   --json FILE         also write all numbers plus machine info (nproc, CPU model, date) as JSON
 # Environment:
@@ -58,6 +62,7 @@ veach_sampler=sobol
 rmse=0
 out_dir=""
 json_out=""
+equal_time=""
 
 die() { echo "compare-mitsuba: $*" >&2; exit 1; }
 need_arg() { [[ $# -ge 2 ]] || die "$1 needs a value"; }
@@ -76,6 +81,7 @@ while [[ $# -gt 0 ]]; do
     --backends) need_arg "$@"; backends=$2; shift 2 ;;
     --veach-sampler) need_arg "$@"; veach_sampler=$2; shift 2 ;;
     --rmse) rmse=1; shift ;;
+    --equal-time) need_arg "$@"; equal_time=$2; shift 2 ;;
     --out-dir) need_arg "$@"; out_dir=$2; shift 2 ;;
     --json) need_arg "$@"; json_out=$2; shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
@@ -147,6 +153,13 @@ if [[ ,$variants, == *,llvm* && -z ${DRJIT_LIBLLVM_PATH:-} ]]; then
   fi
   [[ -n $lib ]] || die "Mitsuba's llvm_ad_rgb needs libLLVM >= 17 (LLVM 15 cannot compile its kernels): apt-get install libllvm19, set DRJIT_LIBLLVM_PATH, or use --variants scalar_rgb"
   export DRJIT_LIBLLVM_PATH=$lib
+fi
+
+if [[ -n $equal_time ]]; then
+  "$py" "$here/mitsuba_scenes.py" equal-time --scenes "$scenes_dir" --times "$equal_time" \
+    --rr-depth "$rr_depth" --seed "$seed" --cbox-ref "$scenes_dir/cbox_ref_d8.exr" \
+    --glass-ref "$repo/tests/data/cbox_glass_64.exr" --veach-ref "$scenes_dir/veach_ref.exr"
+  exit 0
 fi
 
 # ---- work dir -------------------------------------------------------------------------------

@@ -145,6 +145,44 @@ def scene_dict(desc, tmpdir, width, height, spp, depth, rr_depth, seed):
     return d
 
 
+def glass_scene_dict(desc, tmpdir, size, spp, depth, rr_depth, seed):
+    """assets/cornell-glass.gltf for Mitsuba: the Cornell box of `desc` (cbox.json) plus the
+    same triangulated glass sphere (64x32 segments, vertex normals), a dielectric of ior 1.5."""
+    import math
+
+    d = scene_dict(desc, tmpdir, size, size, spp, depth, rr_depth, seed)
+    cx, cy, cz, r = 278.0, 400.0, 300.0, 100.0
+    nu, nv = 64, 32
+    pos, nor, idx = [], [], []
+    for j in range(nv + 1):
+        th = math.pi * j / nv
+        for i in range(nu + 1):
+            ph = 2 * math.pi * i / nu
+            n = (math.sin(th) * math.cos(ph), math.cos(th), math.sin(th) * math.sin(ph))
+            nor.append(n)
+            pos.append((cx + r * n[0], cy + r * n[1], cz + r * n[2]))
+    for j in range(nv):
+        for i in range(nu):
+            a = j * (nu + 1) + i
+            b = a + nu + 1
+            if j > 0:
+                idx.append((a, a + 1, b))
+            if j < nv - 1:
+                idx.append((a + 1, b + 1, b))
+    ply = os.path.join(tmpdir, "sphere.ply")
+    with open(ply, "wb") as f:
+        f.write(b"ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\nproperty float y\n"
+                b"property float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face %d\n"
+                b"property list uchar int vertex_indices\nend_header\n" % (len(pos), len(idx)))
+        for p, n in zip(pos, nor):
+            f.write(struct.pack("<6f", *p, *n))
+        for t in idx:
+            f.write(struct.pack("<B3i", 3, *t))
+    d["glass_sphere"] = {"type": "ply", "filename": ply, "face_normals": False,
+                         "bsdf": {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}}
+    return d
+
+
 def load_scene(json_path, width, height, spp, depth, rr_depth, seed):
     import mitsuba as mi
 
@@ -189,8 +227,11 @@ def convergence_series(scene, spp, seed, reference, until_seconds=0.0):
     while True:
         render_once(scene, n, seed)
         secs, img = render_once(scene, n, seed)
-        rmse = float(np.sqrt(np.mean((img[:, :, :3].astype(np.float64) - reference) ** 2)))
-        series.append({"spp": n, "seconds": secs, "rmse": rmse})
+        img = img[:, :, :3].astype(np.float64)
+        rmse = float(np.sqrt(np.mean((img - reference) ** 2)))
+        # As veach's rmse_clamped: the error a tone-mapped image shows.
+        clamped = float(np.sqrt(np.mean((np.clip(img, 0, 1) - np.clip(reference, 0, 1)) ** 2)))
+        series.append({"spp": n, "seconds": secs, "rmse": rmse, "rmse_clamped": clamped})
         if (n >= spp and secs >= until_seconds) or n >= 16384:
             return series
         n *= 2
@@ -441,11 +482,11 @@ def cmd_report(a):
         print(f"\nwrote {a.json}")
 
 
-def rmse_at(series, t):
+def rmse_at(series, t, key="rmse"):
     """RMSE at time t on the log-log line through the series' neighbouring points (None outside)."""
     import math
 
-    pts = sorted((p["seconds"], p["rmse"]) for p in series if p["seconds"] > 0 and p["rmse"] > 0)
+    pts = sorted((p["seconds"], p[key]) for p in series if p["seconds"] > 0 and p[key] > 0)
     for (t0, e0), (t1, e1) in zip(pts, pts[1:]):
         if t0 <= t <= t1:
             if t1 == t0:
@@ -498,6 +539,32 @@ def report_equal_time(scenes, by, series_dir):
     return out
 
 
+def cmd_equal_time(a):
+    """Mitsuba llvm's clamped RMSE at the given render times on the scenes of bench/adaptive.sh,
+    one line each: scene, seconds, RMSE (log-log interpolation of a timed 1, 2, 4, ... spp
+    series, each render warm)."""
+    import mitsuba as mi
+    import numpy as np
+
+    mi.set_variant("llvm_ad_rgb")
+    times = [float(t) for t in a.times.split()]
+    desc_dir = a.scenes
+    for name, size, depth, ref in (("cbox", 256, 8, a.cbox_ref), ("glass", 64, 8, a.glass_ref),
+                                   ("veach", 256, 2, a.veach_ref)):
+        with tempfile.TemporaryDirectory(prefix="veach-mitsuba-") as tmp:
+            if name == "glass":
+                with open(os.path.join(desc_dir, "cbox.json")) as f:
+                    d = glass_scene_dict(json.load(f), tmp, size, 1, depth, a.rr_depth, a.seed)
+                scene = mi.load_dict(d)
+            else:
+                scene = load_scene(os.path.join(desc_dir, name + ".json"), size, size, 1, depth, a.rr_depth, a.seed)
+        reference = read_rgb(ref).astype(np.float64)
+        series = convergence_series(scene, 1, a.seed, reference, until_seconds=max(times) * 1.05)
+        for t in times:
+            e = rmse_at(series, t, "rmse_clamped")
+            print(f"{name} {t:g} {'nan' if e is None else f'{e:.5f}'}", flush=True)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="cmd", required=True)
@@ -521,8 +588,18 @@ def main():
     r.add_argument("--json")
     r.add_argument("--ref-dir")
     r.add_argument("--series-dir", help="write each convergence series here for veach plot-convergence")
+    e = sub.add_parser("equal-time")
+    e.add_argument("--scenes", required=True, help="the shared scenes (cbox.json, veach.json)")
+    e.add_argument("--cbox-ref", required=True)
+    e.add_argument("--glass-ref", required=True)
+    e.add_argument("--veach-ref", required=True)
+    e.add_argument("--times", default="1 4 16")
+    e.add_argument("--rr-depth", type=int, default=5)
+    e.add_argument("--seed", type=int, default=7)
     a = p.parse_args()
-    if a.cmd == "bench":
+    if a.cmd == "equal-time":
+        cmd_equal_time(a)
+    elif a.cmd == "bench":
         if a.repeat < 1:
             p.error("--repeat must be >= 1")
         cmd_bench(a)
