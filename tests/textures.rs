@@ -229,3 +229,20 @@ fn atlas_reads_agree_across_engines_on_the_gpu() {
     let close = cpu.iter().zip(&gpu).filter(|(a, b)| (*a - *b).abs() <= 1e-4 * a.abs().max(1.0)).count();
     assert!(close as f32 >= 0.98 * cpu.len() as f32, "{close} of {} values agree", cpu.len());
 }
+
+/// A thousand 1024² images (4 GiB) in the 512 MiB budget: every one is halved once before any
+/// is halved twice, and the packed pages fit.
+#[test]
+fn a_thousand_large_images_share_the_budget_fairly() {
+    let sizes = vec![(1024u32, 1024u32); 1000];
+    let budget = veach::packed::TEXTURE_BUDGET_BYTES;
+    let kept = veach::packed::atlas_sizes(&sizes, budget);
+    let sides: std::collections::BTreeSet<u32> = kept.iter().map(|s| s.0).collect();
+    assert!(kept.iter().all(|s| s.0 == s.1 && s.0.is_power_of_two()), "{sides:?}");
+    assert!(sides.len() <= 2 && *sides.last().unwrap() <= 512, "{sides:?}");
+    let (_, pages) = shelf_pack(&kept, veach::packed::MAX_PAGE_SIDE).unwrap();
+    assert!(pages as u64 * 4096 * 4096 * 4 <= budget, "{pages} pages");
+    // Nothing is shrunk that did not have to be: the images fill more than half the budget.
+    let bytes: u64 = kept.iter().map(|s| s.0 as u64 * s.1 as u64 * 4).sum();
+    assert!(bytes * 2 > budget, "{bytes} bytes");
+}

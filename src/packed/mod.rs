@@ -20,8 +20,8 @@ pub use layout::*;
 pub use materials::{dielectric_f0, luminance, pack_material};
 pub use octahedral::{oct_decode, oct_encode};
 pub use textures::{
-    MAX_PAGE_SIDE, MAX_PAGES, Placement, TEXTURE_BUDGET_BYTES, TextureAtlas, pack_textures, pack_textures_within,
-    shelf_pack,
+    MAX_PAGE_SIDE, MAX_PAGES, Placement, TEXTURE_BUDGET_BYTES, TextureAtlas, atlas_sizes, pack_textures,
+    pack_textures_within, shelf_pack,
 };
 
 use crate::accel::{self, cw_slots};

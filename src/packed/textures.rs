@@ -91,15 +91,16 @@ pub fn shelf_pack(sizes: &[(u32, u32)], side: u32) -> Option<(Vec<Placement>, u3
 }
 
 /// The page side (a power of two, from the largest image's to MAX_PAGE_SIDE) whose packing
-/// takes the fewest bytes; ties go to the smaller page.
+/// takes the fewest bytes within MAX_PAGES pages (any within before any beyond); ties go to
+/// the smaller page.
 fn best_packing(sizes: &[(u32, u32)]) -> (Vec<Placement>, u32, u32) {
     let largest = sizes.iter().map(|&(w, h)| w.max(h)).max().unwrap_or(1);
     let mut side = largest.next_power_of_two().min(MAX_PAGE_SIDE);
     let mut best: Option<(Vec<Placement>, u32, u32)> = None;
     while side <= MAX_PAGE_SIDE {
         if let Some((placements, pages)) = shelf_pack(sizes, side) {
-            let bytes = |s: u32, p: u32| p as u64 * (s as u64).pow(2);
-            if best.as_ref().is_none_or(|b| bytes(side, pages) < bytes(b.1, b.2)) {
+            let key = |s: u32, p: u32| (p > MAX_PAGES, p as u64 * (s as u64).pow(2));
+            if best.as_ref().is_none_or(|b| key(side, pages) < key(b.1, b.2)) {
                 best = Some((placements, side, pages));
             }
         }
@@ -109,24 +110,43 @@ fn best_packing(sizes: &[(u32, u32)]) -> (Vec<Placement>, u32, u32) {
     best.unwrap_or_else(|| (vec![Placement::default(); sizes.len()], 1, 1))
 }
 
-/// The sizes the images are stored at: each within a page, and the largest halved (both axes)
-/// until the packed atlas fits `budget` bytes and MAX_PAGES pages.
-pub fn atlas_sizes(textures: &[Texture], budget: u64) -> Vec<(u32, u32)> {
-    let mut sizes: Vec<(u32, u32)> = textures
+fn area(s: &(u32, u32)) -> u64 {
+    s.0 as u64 * s.1 as u64
+}
+
+fn halve(s: &mut (u32, u32)) {
+    *s = ((s.0 / 2).max(1), (s.1 / 2).max(1));
+}
+
+/// Halves the largest images (by area; ties: the first) until all take at most `target`
+/// bytes or every image is one texel.
+fn shrink_to(sizes: &mut [(u32, u32)], target: u64) {
+    use std::cmp::Reverse;
+    let mut total = sizes.iter().map(area).sum::<u64>() * 4;
+    let mut heap: std::collections::BinaryHeap<(u64, Reverse<usize>)> =
+        sizes.iter().enumerate().map(|(i, s)| (area(s), Reverse(i))).collect();
+    while total > target {
+        let Some((a, Reverse(i))) = heap.pop() else { break };
+        if a <= 1 {
+            break;
+        }
+        halve(&mut sizes[i]);
+        total = total - a * 4 + area(&sizes[i]) * 4;
+        heap.push((area(&sizes[i]), Reverse(i)));
+    }
+}
+
+/// The sizes images of `sizes` are stored at: each within a page, and the largest halved
+/// (both axes) until the packed atlas fits `budget` bytes and MAX_PAGES pages.
+pub fn atlas_sizes(sizes: &[(u32, u32)], budget: u64) -> Vec<(u32, u32)> {
+    let mut sizes: Vec<(u32, u32)> = sizes
         .iter()
-        .map(|t| {
-            let (w, h) = (t.width.max(1), t.height.max(1));
+        .map(|&(w, h)| {
+            let (w, h) = (w.max(1), h.max(1));
             let scale = (MAX_PAGE_SIDE as f64 / w.max(h) as f64).min(1.0);
             (((w as f64 * scale).round() as u32).max(1), ((h as f64 * scale).round() as u32).max(1))
         })
         .collect();
-    let area = |s: &(u32, u32)| s.0 as u64 * s.1 as u64;
-    let halve = |s: &mut (u32, u32)| *s = ((s.0 / 2).max(1), (s.1 / 2).max(1));
-    let halve_largest = |sizes: &mut Vec<(u32, u32)>| {
-        if let Some(i) = (0..sizes.len()).max_by_key(|&i| (area(&sizes[i]), std::cmp::Reverse(i))) {
-            halve(&mut sizes[i]);
-        }
-    };
     // A page holds the longest side: one page must fit the budget.
     let page_bytes = |sizes: &[(u32, u32)]| {
         (sizes.iter().map(|s| s.0.max(s.1)).max().unwrap_or(1).next_power_of_two() as u64).pow(2) * 4
@@ -135,17 +155,18 @@ pub fn atlas_sizes(textures: &[Texture], budget: u64) -> Vec<(u32, u32)> {
         let longest = sizes.iter().map(|s| s.0.max(s.1)).max().unwrap_or(1);
         sizes.iter_mut().filter(|s| s.0.max(s.1) == longest).for_each(halve);
     }
-    // Then by area alone (cheap), then by the packing itself (pages waste some room).
-    while sizes.iter().map(area).sum::<u64>() * 4 > budget && sizes.iter().any(|s| area(s) > 1) {
-        halve_largest(&mut sizes);
-    }
+    // Then by area alone (cheap), then by the packing itself: pages waste some room, so the
+    // next target is the images' bytes scaled by how well the last packing used its pages.
+    shrink_to(&mut sizes, budget);
     loop {
         let (_, side, pages) = best_packing(&sizes);
-        let fits = pages as u64 * (side as u64).pow(2) * 4 <= budget && pages <= MAX_PAGES;
-        if fits || sizes.iter().all(|s| area(s) <= 1) {
+        let packed = pages as u64 * (side as u64).pow(2) * 4;
+        if (packed <= budget && pages <= MAX_PAGES) || sizes.iter().all(|s| area(s) <= 1) {
             return sizes;
         }
-        halve_largest(&mut sizes);
+        let images = sizes.iter().map(area).sum::<u64>() * 4;
+        let over = (packed as f64 / budget as f64).max(pages as f64 / MAX_PAGES as f64);
+        shrink_to(&mut sizes, ((images as f64 / over) as u64).min(images - 1));
     }
 }
 
@@ -159,7 +180,7 @@ pub fn pack_textures_within(textures: &[Texture], budget: u64) -> TextureAtlas {
     if textures.is_empty() {
         return TextureAtlas { texels: vec![u32::MAX], side: 1, pages: 1, ..Default::default() };
     }
-    let sizes = atlas_sizes(textures, budget);
+    let sizes = atlas_sizes(&textures.iter().map(|t| (t.width, t.height)).collect::<Vec<_>>(), budget);
     let (placements, side, pages) = best_packing(&sizes);
     use rayon::prelude::*;
     let images: Vec<Vec<u32>> = textures
