@@ -2,7 +2,8 @@
 // (α = roughness²) whose Fresnel term blends the dielectric's and the base color by
 // metallic; under it, the non-metal part splits by KHR_materials_transmission into a
 // Lambertian lobe and a GGX transmission lobe (Walter et al. 2007), both weighted by 1 − F so
-// energy is conserved. α below DELTA_ALPHA makes the specular and transmission lobes Dirac
+// energy is conserved; KHR_materials_diffuse_transmission passes a share of the Lambertian
+// lobe, in its own colour, to the other side. α below DELTA_ALPHA makes the specular and transmission lobes Dirac
 // lobes (mirror, smooth glass).
 // Everything in the local shading frame (normal = +z, wo.z > 0). `eta` is the relative index
 // of refraction across the surface seen from wo (ior entering, 1/ior leaving); transmitted
@@ -73,7 +74,19 @@ fn bsdf_fresnel(m: Material, cos_theta: f32, eta: f32) -> vec3<f32> {
 // Albedo of the Lambertian lobe seen from wo.
 fn diffuse_albedo(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
     let f = dielectric_fresnel(m, cos_o, eta);
-    return (1.0 - m.metallic) * (1.0 - m.transmission) * m.base_color * (vec3<f32>(1.0) - f);
+    return (1.0 - m.metallic) * (1.0 - m.transmission) * (1.0 - m.diffuse_transmission) * m.base_color
+        * (vec3<f32>(1.0) - f);
+}
+
+// KHR_materials_diffuse_transmission's share of the Lambertian lobe: the same lobe mirrored to
+// the other side, in its own colour.
+fn diffuse_transmission_albedo(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
+    if (!DIFFUSE_TRANSMISSION || m.diffuse_transmission <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let f = dielectric_fresnel(m, cos_o, eta);
+    return (1.0 - m.metallic) * (1.0 - m.transmission) * m.diffuse_transmission * m.diffuse_transmission_color
+        * (vec3<f32>(1.0) - f);
 }
 
 // Estimated albedo of the transmission lobe seen from wo.
@@ -85,22 +98,28 @@ fn transmission_albedo(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
     return (1.0 - m.metallic) * m.transmission * m.base_color * (vec3<f32>(1.0) - f);
 }
 
-// Probabilities of sampling the specular, diffuse and transmission lobes, from their albedos.
-// A rough interface transmits through some microfacets even beyond the critical angle of the
-// macro surface, so its transmission lobe keeps at least a tenth of its weight.
-fn lobe_weights(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
+// Probabilities of sampling the specular, diffuse, transmission and diffuse-transmission
+// lobes, from their albedos. A rough interface transmits through some microfacets even beyond
+// the critical angle of the macro surface, so its transmission lobe keeps at least a tenth of
+// its weight.
+fn lobe_weights(m: Material, cos_o: f32, eta: f32) -> vec4<f32> {
     var wt = luminance(transmission_albedo(m, cos_o, eta));
     if (TRANSMISSION && m.roughness * m.roughness >= DELTA_ALPHA) {
         wt = max(wt, 0.1 * (1.0 - m.metallic) * m.transmission * luminance(m.base_color));
     }
-    return vec3<f32>(luminance(bsdf_fresnel(m, cos_o, eta)), luminance(diffuse_albedo(m, cos_o, eta)), wt);
+    return vec4<f32>(
+        luminance(bsdf_fresnel(m, cos_o, eta)),
+        luminance(diffuse_albedo(m, cos_o, eta)),
+        wt,
+        luminance(diffuse_transmission_albedo(m, cos_o, eta)),
+    );
 }
 
-fn lobe_probabilities(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
+fn lobe_probabilities(m: Material, cos_o: f32, eta: f32) -> vec4<f32> {
     let w = lobe_weights(m, cos_o, eta);
-    let total = w.x + w.y + w.z;
+    let total = w.x + w.y + w.z + w.w;
     if (total <= 0.0) {
-        return vec3<f32>(0.0);
+        return vec4<f32>(0.0);
     }
     return w / total;
 }
@@ -191,6 +210,43 @@ fn refract_dir(wo: vec3<f32>, n: vec3<f32>, eta: f32) -> vec4<f32> {
     return vec4<f32>(-wo / eta + (cos_i / eta - cos_t) * n, 1.0);
 }
 
+// The rough transmission lobe's f (wi.z < 0; thin walls pass a reflection through the sheet).
+fn specular_transmission_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32, alpha: f32) -> vec3<f32> {
+    if ((m.flags & MAT_THIN_WALLED) != 0u) {
+        let r = thin_reflection(wi);
+        let h = normalize(wo + r);
+        let f = fresnel_dielectric(dot(wo, h), eta);
+        let ft = ggx_d(h, alpha) * ggx_g2(wo, r, alpha) * (1.0 - f) / (4.0 * wo.z * r.z);
+        return (1.0 - m.metallic) * m.transmission * m.base_color * ft;
+    }
+    let hd = refraction_half_vector(wo, wi, eta);
+    if (hd.w <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let h = hd.xyz;
+    let f = fresnel_dielectric(dot(wo, h), eta);
+    let ft = ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) * (1.0 - f)
+        * abs(dot(wi, h) * dot(wo, h) / (wi.z * wo.z * hd.w)) / (eta * eta);
+    return (1.0 - m.metallic) * m.transmission * m.base_color * ft;
+}
+
+// The rough transmission lobe's density of wi (wi.z < 0) times p_lobe, the probability of
+// choosing the lobe (multiplied first, as the films recorded before the lobe had a function of
+// its own were computed).
+fn specular_transmission_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32, alpha: f32, p_lobe: f32) -> f32 {
+    if ((m.flags & MAT_THIN_WALLED) != 0u) {
+        let r = thin_reflection(wi);
+        return p_lobe * ggx_reflection_pdf(wo, normalize(wo + r), alpha);
+    }
+    let hd = refraction_half_vector(wo, wi, eta);
+    if (hd.w <= 0.0) {
+        return 0.0;
+    }
+    let h = hd.xyz;
+    let d_wo = ggx_g1(wo, alpha) * ggx_d(h, alpha) * dot(wo, h) / wo.z;
+    return p_lobe * d_wo * abs(dot(wi, h)) / hd.w;
+}
+
 // f(wo, wi) without the cosine; Dirac lobes are not included.
 fn base_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec3<f32> {
     let alpha = m.roughness * m.roughness;
@@ -198,25 +254,11 @@ fn base_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     if (wi.z < 0.0) {
-        if (!TRANSMISSION || alpha < DELTA_ALPHA || m.transmission <= 0.0) {
-            return vec3<f32>(0.0);
+        var f = diffuse_transmission_albedo(m, wo.z, eta) * INV_PI;
+        if (TRANSMISSION && alpha >= DELTA_ALPHA && m.transmission > 0.0) {
+            f += specular_transmission_eval(m, wo, wi, eta, alpha);
         }
-        if ((m.flags & MAT_THIN_WALLED) != 0u) {
-            let r = thin_reflection(wi);
-            let h = normalize(wo + r);
-            let f = fresnel_dielectric(dot(wo, h), eta);
-            let ft = ggx_d(h, alpha) * ggx_g2(wo, r, alpha) * (1.0 - f) / (4.0 * wo.z * r.z);
-            return (1.0 - m.metallic) * m.transmission * m.base_color * ft;
-        }
-        let hd = refraction_half_vector(wo, wi, eta);
-        if (hd.w <= 0.0) {
-            return vec3<f32>(0.0);
-        }
-        let h = hd.xyz;
-        let f = fresnel_dielectric(dot(wo, h), eta);
-        let ft = ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) * (1.0 - f)
-            * abs(dot(wi, h) * dot(wo, h) / (wi.z * wo.z * hd.w)) / (eta * eta);
-        return (1.0 - m.metallic) * m.transmission * m.base_color * ft;
+        return f;
     }
     var f = diffuse_albedo(m, wo.z, eta) * INV_PI;
     if (specular_is_rough(m, alpha)) {
@@ -234,20 +276,11 @@ fn base_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> f32 {
     let p = lobe_probabilities(m, wo.z, eta);
     let alpha = m.roughness * m.roughness;
     if (wi.z < 0.0) {
-        if (!TRANSMISSION || alpha < DELTA_ALPHA || p.z <= 0.0) {
-            return 0.0;
+        var pdf = p.w * cosine_hemisphere_pdf(-wi.z);
+        if (TRANSMISSION && alpha >= DELTA_ALPHA && p.z > 0.0) {
+            pdf += specular_transmission_pdf(m, wo, wi, eta, alpha, p.z);
         }
-        if ((m.flags & MAT_THIN_WALLED) != 0u) {
-            let r = thin_reflection(wi);
-            return p.z * ggx_reflection_pdf(wo, normalize(wo + r), alpha);
-        }
-        let hd = refraction_half_vector(wo, wi, eta);
-        if (hd.w <= 0.0) {
-            return 0.0;
-        }
-        let h = hd.xyz;
-        let d_wo = ggx_g1(wo, alpha) * ggx_d(h, alpha) * dot(wo, h) / wo.z;
-        return p.z * d_wo * abs(dot(wi, h)) / hd.w;
+        return pdf;
     }
     var pdf = p.y * cosine_hemisphere_pdf(wi.z);
     if (specular_is_rough(m, alpha) && p.x > 0.0) {
@@ -277,6 +310,9 @@ fn base_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample
         }
     } else if (u.x < p.x + p.y) {
         wi = sample_cosine_hemisphere(u.yz);
+    } else if (u.x < p.x + p.y + p.w) {
+        let w = sample_cosine_hemisphere(u.yz);
+        wi = vec3<f32>(w.x, w.y, -w.z);
     } else {
         if (!TRANSMISSION || p.z <= 0.0) {
             return none;
@@ -342,7 +378,7 @@ fn layer_probabilities(m: Material, wo: vec3<f32>, eta: f32) -> vec3<f32> {
     let w = vec3<f32>(
         coat,
         (1.0 - coat) * luminance(m.sheen_color) * e,
-        (1.0 - coat) * (1.0 - max_component(m.sheen_color) * e) * (b.x + b.y + b.z),
+        (1.0 - coat) * (1.0 - max_component(m.sheen_color) * e) * (b.x + b.y + b.z + b.w),
     );
     let total = w.x + w.y + w.z;
     if (total <= 0.0) {
@@ -435,7 +471,8 @@ fn bsdf_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample
 fn bsdf_is_delta(m: Material, wo: vec3<f32>, eta: f32) -> bool {
     let alpha = m.roughness * m.roughness;
     let p = lobe_probabilities(m, wo.z, eta);
-    let base = p.y <= 0.0 && (p.x <= 0.0 || !specular_is_rough(m, alpha)) && (p.z <= 0.0 || alpha < DELTA_ALPHA);
+    let base = p.y <= 0.0 && p.w <= 0.0 && (p.x <= 0.0 || !specular_is_rough(m, alpha))
+        && (p.z <= 0.0 || alpha < DELTA_ALPHA);
     if (!has_layers(m)) {
         return base;
     }
@@ -448,7 +485,8 @@ fn bsdf_is_delta(m: Material, wo: vec3<f32>, eta: f32) -> bool {
 // clear coat absorbs nothing and is left out, as Open Image Denoise advises.
 fn bsdf_albedo(m: Material, wo: vec3<f32>, eta: f32) -> vec3<f32> {
     let c = max(wo.z, 0.0);
-    let base = bsdf_fresnel(m, c, eta) + diffuse_albedo(m, c, eta) + transmission_albedo(m, c, eta);
+    let base = bsdf_fresnel(m, c, eta) + diffuse_albedo(m, c, eta) + transmission_albedo(m, c, eta)
+        + diffuse_transmission_albedo(m, c, eta);
     var albedo = base;
     if (SHEEN && max_component(m.sheen_color) > 0.0) {
         let e = sheen_albedo(c, m.sheen_roughness);

@@ -22,6 +22,7 @@ override CLEARCOAT: bool = true;
 override SHEEN: bool = true;
 override ANISOTROPY: bool = true;
 override IRIDESCENCE: bool = true;
+override DIFFUSE_TRANSMISSION: bool = true;
 // The render accumulates AOVs (aov.wgsl); not a scene feature but a setting.
 override AOVS: bool = false;
 // Triangles carry COLOR_0 or TEXCOORD_1 (material.wgsl, triangle_uv and vertex_color).
@@ -127,7 +128,8 @@ struct Material {
     anisotropy: f32,
     // ((ior − 1)/(ior + 1))² × specularColor before clamping, for specular textures.
     specular_f0: vec3<f32>,
-    pad0: f32,
+    // KHR_materials_diffuse_transmission's share of the diffuse lobe (0: none) and colour.
+    diffuse_transmission: f32,
     // (cos, sin) of the anisotropy's rotation, and its direction in the local frame's xy
     // plane ((1, 0) in the buffer, set per hit).
     anisotropy_rotation: vec2<f32>,
@@ -138,6 +140,8 @@ struct Material {
     iridescence_ior: f32,
     iridescence_thickness_min: f32,
     iridescence_thickness_max: f32,
+    diffuse_transmission_color: vec3<f32>,
+    pad0: f32,
     base_color_texture: TextureRef,
     metallic_roughness_texture: TextureRef,
     emissive_texture: TextureRef,
@@ -153,6 +157,8 @@ struct Material {
     anisotropy_texture: TextureRef,
     iridescence_texture: TextureRef,
     iridescence_thickness_texture: TextureRef,
+    diffuse_transmission_texture: TextureRef,
+    diffuse_transmission_color_texture: TextureRef,
 }
 
 // KHR_lights_punctual, four rows of the light-data buffer each.

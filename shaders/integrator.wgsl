@@ -158,7 +158,7 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>, aov: ptr<function, AovSa
 
         // Next-event estimation: one light sample. With the BSDF strategy alone it still
         // runs for the tree's Dirac lights, which nothing else can find.
-        let ctx = LightContext(point, ns, m.transmission <= 0.0);
+        let ctx = LightContext(point, ns, m.transmission <= 0.0 && m.diffuse_transmission <= 0.0);
         let tree = params.light_sampler == LIGHT_SAMPLER_TREE;
         let nee_lights = select(params.light_count, params.tree_emitters, tree);
         var nee = nee_lights > 0u || params.env_select > 0.0;

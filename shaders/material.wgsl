@@ -92,6 +92,13 @@ fn material_at(m: Material, uv: vec4<f32>, color: vec4<f32>) -> Material {
         let t = sample_texture(m.iridescence_thickness_texture, uv).y;
         r.iridescence_thickness_max = mix(m.iridescence_thickness_min, m.iridescence_thickness_max, t);
     }
+    if (TEXTURES && DIFFUSE_TRANSMISSION && m.diffuse_transmission_texture.atlas != NO_TEXTURE) {
+        r.diffuse_transmission = m.diffuse_transmission * sample_texture(m.diffuse_transmission_texture, uv).w;
+    }
+    if (TEXTURES && DIFFUSE_TRANSMISSION && m.diffuse_transmission_color_texture.atlas != NO_TEXTURE) {
+        r.diffuse_transmission_color = m.diffuse_transmission_color
+            * sample_texture(m.diffuse_transmission_color_texture, uv).xyz;
+    }
     return r;
 }
 

@@ -4,7 +4,8 @@
 //! tested from both sides, entering (η = 1.5) and leaving (η = 1/1.5, with total internal
 //! reflection). The layers over the base — KHR_materials_clearcoat's coat (with a coat
 //! normal of its own) and KHR_materials_sheen's sheen — are tested alone, together and over
-//! metal, plastic and glass.
+//! metal, plastic and glass. KHR_materials_diffuse_transmission's Lambertian lobe through
+//! the surface is tested alone, beside rough thin glass and under a coat.
 
 mod common;
 
@@ -44,6 +45,11 @@ fn sheened(base: Material, color: Vec3, roughness: f32) -> Material {
 
 fn plastic(base: f32, roughness: f32) -> Material {
     Material { base_color: Vec3::new(base, base * 0.8, base * 0.6), metallic: 0.0, roughness, ..Material::default() }
+}
+
+/// KHR_materials_diffuse_transmission of this share and colour over `base`.
+fn translucent(base: Material, share: f32, color: Vec3) -> Material {
+    Material { diffuse_transmission: share, diffuse_transmission_color: color, ..base }
 }
 
 fn thin(roughness: f32, transmission: f32) -> PackedMaterial {
@@ -125,6 +131,24 @@ fn cases() -> Vec<(String, PackedMaterial, f32)> {
         1.5,
     ));
     v.push((
+        "diffuse transmission 1 under plastic r=0.5".to_string(),
+        pack_material(&translucent(plastic(0.6, 0.5), 1.0, Vec3::new(0.9, 0.6, 0.3)), &[]),
+        1.5,
+    ));
+    v.push((
+        "thin glass r=0.5 beside diffuse transmission 0.6".to_string(),
+        pack_material(
+            &translucent(Material { transmission: 0.5, thin_walled: true, ..plastic(0.8, 0.5) }, 0.6, Vec3::ONE),
+            &[],
+        ),
+        1.5,
+    ));
+    v.push((
+        "coat r=0.3 over diffuse transmission 0.5".to_string(),
+        coated(translucent(plastic(0.7, 0.4), 0.5, Vec3::new(0.5, 0.8, 1.0)), 0.3, 0.1),
+        1.5,
+    ));
+    v.push((
         "coat r=0.3 over rough glass".to_string(),
         coated(Material { transmission: 1.0, ..plastic(1.0, 0.5) }, 0.3, 0.0),
         1.5,
@@ -169,8 +193,9 @@ fn sampled_albedo_equals_quadrature() {
         for theta_o in [10f32, 45.0, 80.0] {
             let t = theta_o.to_radians();
             let wo = Vec3::new(t.sin(), 0.0, t.cos());
-            // Quadrature of f·|cos| over the sphere in (cos θ, φ); the transmitted part also
-            // times η², which undoes the radiance scaling: that sum is the energy kept.
+            // Quadrature of f·|cos| over the sphere in (cos θ, φ); the refracted part (thick
+            // glass) also times η², which undoes the radiance scaling: that sum is the energy
+            // kept. Diffuse transmission does not bend light, nor scale radiance.
             let (nc, np) = (1600usize, 400usize);
             let mut quad = Vec3::ZERO.as_dvec3();
             let mut energy = 0.0f64;
@@ -182,7 +207,8 @@ fn sampled_albedo_equals_quadrature() {
                     let fc = (bsdf_eval(&m, wo, wi, eta) * c.abs()).as_dvec3();
                     quad += fc;
                     let thin_wall = m.flags & veach::packed::MAT_THIN_WALLED != 0;
-                    energy += fc.y * if c < 0.0 && !thin_wall { (eta * eta) as f64 } else { 1.0 };
+                    let refracts = c < 0.0 && !thin_wall && m.transmission > 0.0;
+                    energy += fc.y * if refracts { (eta * eta) as f64 } else { 1.0 };
                 }
             }
             let scale = 4.0 * std::f64::consts::PI / (nc * np) as f64;
@@ -436,4 +462,43 @@ fn thin_films_fade_to_the_base_and_stay_in_range() {
         }
     }
     assert!(spread > 0.1, "a 350 nm film does not colour its reflection (spread {spread})");
+}
+
+/// KHR_materials_diffuse_transmission moves a share of the Lambertian lobe to the other side
+/// in its own colour: with specular 0 (no Fresnel), a quadrature of f·|cos| gives
+/// (1 − share)·base colour above the surface and share·transmission colour below, from every
+/// angle, and the sum of a white one is 1.
+#[test]
+fn diffuse_transmission_moves_its_share_to_the_other_side() {
+    let (base, color, share) = (Vec3::new(0.2, 0.6, 0.9), Vec3::new(0.9, 0.5, 0.1), 0.3);
+    let m = pack_material(
+        &translucent(
+            Material { base_color: base, metallic: 0.0, specular_factor: 0.0, ..Material::default() },
+            share,
+            color,
+        ),
+        &[],
+    );
+    for theta_o in [0f32, 40.0, 85.0] {
+        let t = theta_o.to_radians();
+        let wo = Vec3::new(t.sin(), 0.0, t.cos());
+        let (nc, np) = (400usize, 100usize);
+        let (mut above, mut below) = (glam::DVec3::ZERO, glam::DVec3::ZERO);
+        for i in 0..nc {
+            let c = -1.0 + 2.0 * (i as f32 + 0.5) / nc as f32;
+            for j in 0..np {
+                let wi = direction(c, (j as f32 + 0.5) / np as f32 * 2.0 * PI);
+                let fc = (bsdf_eval(&m, wo, wi, 1.5) * c.abs()).as_dvec3();
+                if c > 0.0 { above += fc } else { below += fc }
+            }
+        }
+        let scale = 4.0 * std::f64::consts::PI / (nc * np) as f64;
+        let (above, below) = (above * scale, below * scale);
+        let (want_above, want_below) = (((1.0 - share) * base).as_dvec3(), (share * color).as_dvec3());
+        assert!((above - want_above).abs().max_element() < 1e-3, "θo={theta_o}: reflected {above}, want {want_above}");
+        assert!(
+            (below - want_below).abs().max_element() < 1e-3,
+            "θo={theta_o}: transmitted {below}, want {want_below}"
+        );
+    }
 }

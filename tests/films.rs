@@ -39,9 +39,10 @@ const FILMS: &[(&str, u32, veach::SamplerKind, veach::LightSampler, u64)] = &[
 ];
 
 /// A scene that turns on every optional part of the kernel: a texture with alpha MASK, BLEND,
-/// a spot light, glass with absorption, instancing, a constant environment.
-fn features_scene() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("veach-films-{}", std::process::id()));
+/// a spot light, glass with absorption, instancing, a constant environment. Written to a
+/// directory of the caller's (`engine`): the two tests run at once.
+fn features_scene(engine: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("veach-films-{}-{engine}", std::process::id()));
     let mut b = GltfBuilder::new(&dir, "features");
     b.use_extension("KHR_materials_transmission");
     b.use_extension("KHR_materials_volume");
@@ -78,7 +79,7 @@ fn features_scene() -> PathBuf {
 }
 
 /// The films this test renders: (name, scene file, settings).
-fn cases() -> Vec<(String, PathBuf, Settings)> {
+fn cases(engine: &str) -> Vec<(String, PathBuf, Settings)> {
     let mut out = Vec::new();
     for &(scene, max_depth, sampler, light_sampler, _) in FILMS {
         let settings =
@@ -95,7 +96,7 @@ fn cases() -> Vec<(String, PathBuf, Settings)> {
             light_sampler,
             ..Settings::default()
         };
-        out.push((format!("features {light_sampler:?}"), features_scene(), settings));
+        out.push((format!("features {light_sampler:?}"), features_scene(engine), settings));
     }
     out
 }
@@ -130,7 +131,7 @@ fn gpu_films_of_bundled_scenes_are_unchanged() {
         return;
     };
     let mut got = Vec::new();
-    for (_, path, settings) in cases() {
+    for (_, path, settings) in cases("gpu") {
         let film = common::render(&path, &settings, 4, Some(ctx.clone()));
         got.push(fnv(&film.data));
     }
@@ -146,7 +147,7 @@ fn cpu_films_of_bundled_scenes_are_unchanged() {
     }
     let mut wrong = Vec::new();
     let expected = FILMS.iter().map(|f| f.4).chain(FEATURES_CPU);
-    for ((name, path, settings), expected) in cases().into_iter().zip(expected) {
+    for ((name, path, settings), expected) in cases("cpu").into_iter().zip(expected) {
         let film = common::render(&path, &settings, 4, None);
         let h = fnv(&film.data);
         if h != expected {

@@ -442,7 +442,8 @@ fn furnace_mean(film: &Film) -> (f64, f64) {
 /// bounces: the layers may lose what their model loses, never gain. A smooth coat loses
 /// nothing (Fresnel splits between the mirror and the base); a rough one the energy of its
 /// single-scattering GGX lobe times its Fresnel weight (a few %, tests/bsdf.rs); a white
-/// sheen what the albedo scaling's smaller direction withholds. The GPU agrees with the CPU
+/// sheen what the albedo scaling's smaller direction withholds; diffuse transmission nothing
+/// (white, it splits the Lambertian lobe between the two sides). The GPU agrees with the CPU
 /// within error bars.
 fn layered_materials_on(ctx: Option<GpuContext>) {
     let white = |ext: serde_json::Value| {
@@ -470,12 +471,29 @@ fn layered_materials_on(ctx: Option<GpuContext>) {
                 "KHR_materials_sheen": {"sheenColorFactor": [0.9, 0.6, 0.3], "sheenRoughnessFactor": 0.3}}),
             0.88,
         ),
+        (
+            "diffuse-transmission",
+            json!({"KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 0.7}}),
+            0.995,
+        ),
+        (
+            "coat-over-diffuse-transmission",
+            json!({"KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.3},
+                "KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1.0}}),
+            0.97,
+        ),
     ];
     for (name, ext, min_mean) in cases {
         let path = furnace_of(
             &format!("{name}-{}", engine(&ctx)),
             white(ext),
-            &["KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_iridescence"],
+            &[
+                "KHR_materials_specular",
+                "KHR_materials_clearcoat",
+                "KHR_materials_sheen",
+                "KHR_materials_iridescence",
+                "KHR_materials_diffuse_transmission",
+            ],
         );
         let loaded = veach::load(&path, None).unwrap();
         assert!(loaded.warnings.is_empty(), "{name}: {:?}", loaded.warnings);
@@ -630,6 +648,76 @@ fn clearcoat_and_sheen_load_with_their_textures() {
 fn clearcoat_and_sheen_load_with_their_textures_on_the_gpu() {
     let Some(ctx) = gpu("clearcoat_and_sheen_load_with_their_textures_on_the_gpu") else { return };
     clearcoat_and_sheen_on(Some(ctx));
+}
+
+/// KHR_materials_diffuse_transmission: a sheet (specular 0, so no Fresnel) filling the view in
+/// a white environment shows (1 − share)·base colour reflected plus share·transmission colour
+/// from behind, channel by channel, on both engines (the GPU also agrees with the CPU); the
+/// extension's textures load.
+fn diffuse_transmission_on(ctx: Option<GpuContext>) {
+    let d = dir(&format!("diffuse-transmission-{}", engine(&ctx)));
+    let mut b = GltfBuilder::new(&d, "translucent");
+    for e in ["KHR_materials_diffuse_transmission", "KHR_materials_specular"] {
+        b.use_extension(e);
+    }
+    let (base, color, share) = (Vec3::new(0.2, 0.6, 0.9), Vec3::new(0.9, 0.5, 0.1), 0.3);
+    let m = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [base.x, base.y, base.z, 1],
+        "metallicFactor": 0, "roughnessFactor": 0.5}, "extensions": {
+        "KHR_materials_specular": {"specularFactor": 0.0},
+        "KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": share,
+            "diffuseTransmissionColorFactor": [color.x, color.y, color.z]}}}));
+    let quad = b.mesh(&MeshData::quad(-3.0, -3.0, 3.0, 3.0, 0.0, MeshData::UPRIGHT), m);
+    b.node(json!({"mesh": quad}));
+    camera_for(&mut b, 3.0, 1.0, 1.0);
+    let path = b.write();
+    let loaded = veach::load(&path, None).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let mat = &loaded.scene.materials[0];
+    assert_eq!((mat.diffuse_transmission, mat.diffuse_transmission_color), (share, color));
+    let s = Settings { width: 24, height: 24, max_depth: 0, env_color: Some([1.0; 3]), ..Settings::default() };
+    let (backend, film) = render_on(&path, &s, 16, ctx.clone());
+    assert_eq!(film.nonfinite_samples(), 0, "{backend}");
+    let (mean, var) = film_stats(&film);
+    let n = mean.len() as f64;
+    let m: glam::DVec3 = mean.iter().map(|v| v.as_dvec3()).sum::<glam::DVec3>() / n;
+    let se = var.iter().map(|v| v.as_dvec3()).sum::<glam::DVec3>().max(glam::DVec3::ZERO).sqrt() / n;
+    let want = ((1.0 - share) * base + share * color).as_dvec3();
+    for c in 0..3 {
+        assert!((m[c] - want[c]).abs() <= 4.0 * se[c] + 1e-3, "{backend}: mean {m} ± {se}, want {want}");
+    }
+    if ctx.is_some() {
+        let (_, cpu) = render_on(&path, &s, 16, None);
+        let (cm, cv) = film_stats(&cpu);
+        let a = agreement(&mean, &var, &cm, &cv);
+        assert!(a.mean_z.abs().max_element() < 5.0, "GPU vs CPU {a:?}");
+    } else {
+        // The textures: the share in alpha, the colour in sRGB RGB.
+        let d = dir("diffuse-transmission-textures");
+        let mut b = GltfBuilder::new(&d, "textured");
+        b.use_extension("KHR_materials_diffuse_transmission");
+        let t = b.texture(&block_texture(), REPEAT);
+        let m = b.material(json!({"extensions": {"KHR_materials_diffuse_transmission": {
+            "diffuseTransmissionFactor": 1.0, "diffuseTransmissionTexture": {"index": t},
+            "diffuseTransmissionColorTexture": {"index": t}}}}));
+        let quad = b.mesh(&MeshData::quad(-1.0, -1.0, 1.0, 1.0, 0.0, MeshData::UPRIGHT), m);
+        b.node(json!({"mesh": quad}));
+        camera_for(&mut b, 3.0, 1.0, 1.0);
+        let loaded = veach::load(&b.write(), None).unwrap();
+        let mat = &loaded.scene.materials[0];
+        assert!(mat.diffuse_transmission_texture.is_some() && mat.diffuse_transmission_color_texture.is_some());
+    }
+}
+
+#[test]
+fn diffuse_transmission_shows_its_colour_from_behind() {
+    diffuse_transmission_on(None);
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn diffuse_transmission_shows_its_colour_from_behind_on_the_gpu() {
+    let Some(ctx) = gpu("diffuse_transmission_shows_its_colour_from_behind_on_the_gpu") else { return };
+    diffuse_transmission_on(Some(ctx));
 }
 
 fn glass_furnace_on(ctx: Option<GpuContext>) {

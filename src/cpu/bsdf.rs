@@ -1,5 +1,6 @@
 //! Twin of `shaders/bsdf.wgsl`: glTF metallic-roughness (GGX specular over Lambert and GGX
-//! transmission), under KHR_materials_sheen's sheen and KHR_materials_clearcoat's coat.
+//! transmission, with KHR_materials_diffuse_transmission's Lambertian lobe through the surface),
+//! under KHR_materials_sheen's sheen and KHR_materials_clearcoat's coat.
 
 use super::clearcoat::{coat_alpha, coat_eval, coat_pdf, coat_sample, coat_weight};
 use super::iridescence::iridescence_fresnel;
@@ -76,7 +77,26 @@ pub fn bsdf_fresnel(m: &Material, cos_theta: f32, eta: f32) -> Vec3 {
 #[inline]
 pub fn diffuse_albedo(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
     let f = dielectric_fresnel(m, cos_o, eta);
-    (1.0 - m.metallic) * (1.0 - m.transmission) * Vec3::from(m.base_color) * (Vec3::ONE - f)
+    (1.0 - m.metallic)
+        * (1.0 - m.transmission)
+        * (1.0 - m.diffuse_transmission)
+        * Vec3::from(m.base_color)
+        * (Vec3::ONE - f)
+}
+
+/// KHR_materials_diffuse_transmission's share of the Lambertian lobe: the same lobe mirrored
+/// to the other side, in its own colour.
+#[inline]
+pub fn diffuse_transmission_albedo(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
+    if m.diffuse_transmission <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let f = dielectric_fresnel(m, cos_o, eta);
+    (1.0 - m.metallic)
+        * (1.0 - m.transmission)
+        * m.diffuse_transmission
+        * Vec3::from(m.diffuse_transmission_color)
+        * (Vec3::ONE - f)
 }
 
 #[inline]
@@ -85,21 +105,27 @@ pub fn transmission_albedo(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
     (1.0 - m.metallic) * m.transmission * Vec3::from(m.base_color) * (Vec3::ONE - f)
 }
 
+/// Weights of the specular, diffuse, transmission and diffuse-transmission lobes.
 #[inline]
-pub fn lobe_weights(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
+pub fn lobe_weights(m: &Material, cos_o: f32, eta: f32) -> Vec4 {
     let mut wt = luminance(transmission_albedo(m, cos_o, eta));
     if m.roughness * m.roughness >= DELTA_ALPHA {
         wt = wt.max(0.1 * (1.0 - m.metallic) * m.transmission * luminance(m.base_color.into()));
     }
-    Vec3::new(luminance(bsdf_fresnel(m, cos_o, eta)), luminance(diffuse_albedo(m, cos_o, eta)), wt)
+    Vec4::new(
+        luminance(bsdf_fresnel(m, cos_o, eta)),
+        luminance(diffuse_albedo(m, cos_o, eta)),
+        wt,
+        luminance(diffuse_transmission_albedo(m, cos_o, eta)),
+    )
 }
 
 #[inline]
-pub fn lobe_probabilities(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
+pub fn lobe_probabilities(m: &Material, cos_o: f32, eta: f32) -> Vec4 {
     let w = lobe_weights(m, cos_o, eta);
-    let total = w.x + w.y + w.z;
+    let total = w.x + w.y + w.z + w.w;
     if total <= 0.0 {
-        return Vec3::ZERO;
+        return Vec4::ZERO;
     }
     w / total
 }
@@ -195,32 +221,37 @@ pub fn refract_dir(wo: Vec3, n: Vec3, eta: f32) -> Vec4 {
     (-wo / eta + (cos_i / eta - cos_t) * n).extend(1.0)
 }
 
+/// The rough transmission lobe's f (wi.z < 0; thin walls pass a reflection through the sheet).
+pub fn specular_transmission_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32, alpha: f32) -> Vec3 {
+    if m.flags & MAT_THIN_WALLED != 0 {
+        let r = thin_reflection(wi);
+        let h = (wo + r).normalize();
+        let f = fresnel_dielectric(wo.dot(h), eta);
+        let ft = ggx_d(h, alpha) * ggx_g2(wo, r, alpha) * (1.0 - f) / (4.0 * wo.z * r.z);
+        return (1.0 - m.metallic) * m.transmission * Vec3::from(m.base_color) * ft;
+    }
+    let hd = refraction_half_vector(wo, wi, eta);
+    if hd.w <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let h = hd.truncate();
+    let f = fresnel_dielectric(wo.dot(h), eta);
+    let ft = ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) * (1.0 - f) * (wi.dot(h) * wo.dot(h) / (wi.z * wo.z * hd.w)).abs()
+        / (eta * eta);
+    (1.0 - m.metallic) * m.transmission * Vec3::from(m.base_color) * ft
+}
+
 pub fn base_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
     let alpha = m.roughness * m.roughness;
     if wo.z <= 0.0 || wi.z == 0.0 {
         return Vec3::ZERO;
     }
     if wi.z < 0.0 {
-        if alpha < DELTA_ALPHA || m.transmission <= 0.0 {
-            return Vec3::ZERO;
+        let mut f = diffuse_transmission_albedo(m, wo.z, eta) * FRAC_1_PI;
+        if alpha >= DELTA_ALPHA && m.transmission > 0.0 {
+            f += specular_transmission_eval(m, wo, wi, eta, alpha);
         }
-        if m.flags & MAT_THIN_WALLED != 0 {
-            let r = thin_reflection(wi);
-            let h = (wo + r).normalize();
-            let f = fresnel_dielectric(wo.dot(h), eta);
-            let ft = ggx_d(h, alpha) * ggx_g2(wo, r, alpha) * (1.0 - f) / (4.0 * wo.z * r.z);
-            return (1.0 - m.metallic) * m.transmission * Vec3::from(m.base_color) * ft;
-        }
-        let hd = refraction_half_vector(wo, wi, eta);
-        if hd.w <= 0.0 {
-            return Vec3::ZERO;
-        }
-        let h = hd.truncate();
-        let f = fresnel_dielectric(wo.dot(h), eta);
-        let ft =
-            ggx_d(h, alpha) * ggx_g2(wo, wi, alpha) * (1.0 - f) * (wi.dot(h) * wo.dot(h) / (wi.z * wo.z * hd.w)).abs()
-                / (eta * eta);
-        return (1.0 - m.metallic) * m.transmission * Vec3::from(m.base_color) * ft;
+        return f;
     }
     let mut f = diffuse_albedo(m, wo.z, eta) * FRAC_1_PI;
     if specular_is_rough(m, alpha) {
@@ -231,6 +262,23 @@ pub fn base_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
     f
 }
 
+/// The rough transmission lobe's density of wi (wi.z < 0) times `p_lobe`, the probability
+/// of choosing the lobe (multiplied first, as the films recorded before the lobe had a function
+/// of its own were computed).
+pub fn specular_transmission_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32, alpha: f32, p_lobe: f32) -> f32 {
+    if m.flags & MAT_THIN_WALLED != 0 {
+        let r = thin_reflection(wi);
+        return p_lobe * ggx_reflection_pdf(wo, (wo + r).normalize(), alpha);
+    }
+    let hd = refraction_half_vector(wo, wi, eta);
+    if hd.w <= 0.0 {
+        return 0.0;
+    }
+    let h = hd.truncate();
+    let d_wo = ggx_g1(wo, alpha) * ggx_d(h, alpha) * wo.dot(h) / wo.z;
+    p_lobe * d_wo * wi.dot(h).abs() / hd.w
+}
+
 pub fn base_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
     if wo.z <= 0.0 || wi.z == 0.0 {
         return 0.0;
@@ -238,20 +286,11 @@ pub fn base_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
     let p = lobe_probabilities(m, wo.z, eta);
     let alpha = m.roughness * m.roughness;
     if wi.z < 0.0 {
-        if alpha < DELTA_ALPHA || p.z <= 0.0 {
-            return 0.0;
+        let mut pdf = p.w * cosine_hemisphere_pdf(-wi.z);
+        if alpha >= DELTA_ALPHA && p.z > 0.0 {
+            pdf += specular_transmission_pdf(m, wo, wi, eta, alpha, p.z);
         }
-        if m.flags & MAT_THIN_WALLED != 0 {
-            let r = thin_reflection(wi);
-            return p.z * ggx_reflection_pdf(wo, (wo + r).normalize(), alpha);
-        }
-        let hd = refraction_half_vector(wo, wi, eta);
-        if hd.w <= 0.0 {
-            return 0.0;
-        }
-        let h = hd.truncate();
-        let d_wo = ggx_g1(wo, alpha) * ggx_d(h, alpha) * wo.dot(h) / wo.z;
-        return p.z * d_wo * wi.dot(h).abs() / hd.w;
+        return pdf;
     }
     let mut pdf = p.y * cosine_hemisphere_pdf(wi.z);
     if specular_is_rough(m, alpha) && p.x > 0.0 {
@@ -280,6 +319,9 @@ pub fn base_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
         wi
     } else if u.x < p.x + p.y {
         sample_cosine_hemisphere(Vec2::new(u.y, u.z))
+    } else if u.x < p.x + p.y + p.w {
+        let w = sample_cosine_hemisphere(Vec2::new(u.y, u.z));
+        Vec3::new(w.x, w.y, -w.z)
     } else {
         if p.z <= 0.0 {
             return none;
@@ -342,7 +384,7 @@ pub fn layer_probabilities(m: &Material, wo: Vec3, eta: f32) -> Vec3 {
     let w = Vec3::new(
         coat,
         (1.0 - coat) * luminance(sheen) * e,
-        (1.0 - coat) * (1.0 - sheen.max_element() * e) * (b.x + b.y + b.z),
+        (1.0 - coat) * (1.0 - sheen.max_element() * e) * (b.x + b.y + b.z + b.w),
     );
     let total = w.x + w.y + w.z;
     if total <= 0.0 {
@@ -434,7 +476,8 @@ pub fn bsdf_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
 pub fn bsdf_is_delta(m: &Material, wo: Vec3, eta: f32) -> bool {
     let alpha = m.roughness * m.roughness;
     let p = lobe_probabilities(m, wo.z, eta);
-    let base = p.y <= 0.0 && (p.x <= 0.0 || !specular_is_rough(m, alpha)) && (p.z <= 0.0 || alpha < DELTA_ALPHA);
+    let base =
+        p.y <= 0.0 && p.w <= 0.0 && (p.x <= 0.0 || !specular_is_rough(m, alpha)) && (p.z <= 0.0 || alpha < DELTA_ALPHA);
     if !has_layers(m) {
         return base;
     }
@@ -448,7 +491,10 @@ pub fn bsdf_is_delta(m: &Material, wo: Vec3, eta: f32) -> bool {
 /// Twin of `bsdf_albedo`.
 pub fn bsdf_albedo(m: &Material, wo: Vec3, eta: f32) -> Vec3 {
     let c = wo.z.max(0.0);
-    let base = bsdf_fresnel(m, c, eta) + diffuse_albedo(m, c, eta) + transmission_albedo(m, c, eta);
+    let base = bsdf_fresnel(m, c, eta)
+        + diffuse_albedo(m, c, eta)
+        + transmission_albedo(m, c, eta)
+        + diffuse_transmission_albedo(m, c, eta);
     let sheen = Vec3::from(m.sheen_color);
     let albedo = if sheen.max_element() > 0.0 {
         let e = sheen_albedo(c, m.sheen_roughness);

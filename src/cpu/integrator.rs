@@ -180,7 +180,8 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
             break;
         }
 
-        let ctx = LightContext { point, normal: ns, reflect_only: m.transmission <= 0.0 };
+        let ctx =
+            LightContext { point, normal: ns, reflect_only: m.transmission <= 0.0 && m.diffuse_transmission <= 0.0 };
         // Next-event estimation: one light sample. With the BSDF strategy alone it still
         // runs for the tree's Dirac lights, which nothing else can find.
         let nee_lights =

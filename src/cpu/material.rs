@@ -97,6 +97,13 @@ pub fn material_at(scene: &PackedScene, m: &Material, uv: Vec4, color: Vec4) -> 
         r.iridescence_thickness_max =
             m.iridescence_thickness_min + (m.iridescence_thickness_max - m.iridescence_thickness_min) * t;
     }
+    if m.diffuse_transmission_texture.atlas != NO_TEXTURE {
+        r.diffuse_transmission = m.diffuse_transmission * sample_texture(scene, &m.diffuse_transmission_texture, uv).w;
+    }
+    if m.diffuse_transmission_color_texture.atlas != NO_TEXTURE {
+        let c = sample_texture(scene, &m.diffuse_transmission_color_texture, uv).truncate();
+        r.diffuse_transmission_color = (Vec3::from(m.diffuse_transmission_color) * c).into();
+    }
     r
 }
 

@@ -16,6 +16,8 @@ pub struct Features {
     pub sheen: bool,
     pub anisotropy: bool,
     pub iridescence: bool,
+    /// KHR_materials_diffuse_transmission.
+    pub diffuse_transmission: bool,
     /// The render accumulates AOVs (a setting, not a property of the scene: false here, set
     /// by the engine).
     pub aovs: bool,
@@ -25,7 +27,7 @@ pub struct Features {
 
 impl Features {
     /// The pipeline constants of `shaders/common.wgsl`.
-    pub fn constants(&self) -> [(&'static str, f64); 11] {
+    pub fn constants(&self) -> [(&'static str, f64); 12] {
         let f = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("ALPHA_TEST", f(self.alpha_test)),
@@ -37,6 +39,7 @@ impl Features {
             ("SHEEN", f(self.sheen)),
             ("ANISOTROPY", f(self.anisotropy)),
             ("IRIDESCENCE", f(self.iridescence)),
+            ("DIFFUSE_TRANSMISSION", f(self.diffuse_transmission)),
             ("AOVS", f(self.aovs)),
             ("VERTEX_EXTRAS", f(self.vertex_extras)),
         ]
@@ -62,6 +65,8 @@ impl PackedScene {
                 m.anisotropy_texture,
                 m.iridescence_texture,
                 m.iridescence_thickness_texture,
+                m.diffuse_transmission_texture,
+                m.diffuse_transmission_color_texture,
             ]
             .iter()
             .any(|t| t.atlas != NO_TEXTURE)
@@ -76,6 +81,7 @@ impl PackedScene {
             sheen: self.materials.iter().any(|m| m.sheen_color.iter().any(|&c| c > 0.0)),
             anisotropy: self.materials.iter().any(|m| m.anisotropy > 0.0),
             iridescence: self.materials.iter().any(|m| m.iridescence > 0.0),
+            diffuse_transmission: self.materials.iter().any(|m| m.diffuse_transmission > 0.0),
             aovs: false,
             vertex_extras: self.extras_base > 0,
         }

@@ -123,7 +123,8 @@ pub struct Material {
     pub anisotropy: f32,
     /// ((ior − 1)/(ior + 1))² × specularColor before clamping, for specular textures.
     pub specular_f0: [f32; 3],
-    pub pad0: f32,
+    /// KHR_materials_diffuse_transmission's share of the diffuse lobe (0: none).
+    pub diffuse_transmission: f32,
     /// (cos, sin) of the anisotropy's rotation from the tangent.
     pub anisotropy_rotation: [f32; 2],
     /// The anisotropy direction in the local shading frame's xy plane. Not scene data:
@@ -135,6 +136,9 @@ pub struct Material {
     pub iridescence_ior: f32,
     pub iridescence_thickness_min: f32,
     pub iridescence_thickness_max: f32,
+    /// The colour of the diffusely transmitted light.
+    pub diffuse_transmission_color: [f32; 3],
+    pub pad0: f32,
     pub base_color_texture: TextureRef,
     pub metallic_roughness_texture: TextureRef,
     pub emissive_texture: TextureRef,
@@ -150,6 +154,8 @@ pub struct Material {
     pub anisotropy_texture: TextureRef,
     pub iridescence_texture: TextureRef,
     pub iridescence_thickness_texture: TextureRef,
+    pub diffuse_transmission_texture: TextureRef,
+    pub diffuse_transmission_color_texture: TextureRef,
 }
 
 /// A KHR_lights_punctual light as four rows of the light-data buffer.

@@ -28,7 +28,8 @@ pub fn pack_material(m: &Material, atlas: &[Placement]) -> PackedMaterial {
     if thin {
         flags |= MAT_THIN_WALLED;
     }
-    let attenuation = if m.attenuation_distance.is_finite() && !thin {
+    // A thin wall (no volume, or thickness 0) holds no medium, whatever its lobes.
+    let attenuation = if m.attenuation_distance.is_finite() && !m.thin_walled {
         m.attenuation_color.max(Vec3::splat(1e-6)).map(|c| -c.ln() / m.attenuation_distance)
     } else {
         Vec3::ZERO
@@ -55,13 +56,15 @@ pub fn pack_material(m: &Material, atlas: &[Placement]) -> PackedMaterial {
         coat_normal: [0.0, 0.0, 1.0],
         anisotropy: m.anisotropy,
         specular_f0: specular_f0(m).into(),
-        pad0: 0.0,
+        diffuse_transmission: m.diffuse_transmission,
         anisotropy_rotation: [m.anisotropy_rotation.cos(), m.anisotropy_rotation.sin()],
         anisotropy_tangent: [1.0, 0.0],
         iridescence: m.iridescence,
         iridescence_ior: m.iridescence_ior,
         iridescence_thickness_min: m.iridescence_thickness_min,
         iridescence_thickness_max: m.iridescence_thickness_max,
+        diffuse_transmission_color: m.diffuse_transmission_color.into(),
+        pad0: 0.0,
         base_color_texture: pack_texture_ref(m.base_color_texture, true),
         metallic_roughness_texture: pack_texture_ref(m.metallic_roughness_texture, false),
         emissive_texture: pack_texture_ref(m.emissive_texture, true),
@@ -77,6 +80,8 @@ pub fn pack_material(m: &Material, atlas: &[Placement]) -> PackedMaterial {
         anisotropy_texture: pack_texture_ref(m.anisotropy_texture, false),
         iridescence_texture: pack_texture_ref(m.iridescence_texture, false),
         iridescence_thickness_texture: pack_texture_ref(m.iridescence_thickness_texture, false),
+        diffuse_transmission_texture: pack_texture_ref(m.diffuse_transmission_texture, false),
+        diffuse_transmission_color_texture: pack_texture_ref(m.diffuse_transmission_color_texture, true),
     }
 }
 

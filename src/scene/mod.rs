@@ -183,6 +183,14 @@ pub struct Material {
     pub iridescence_thickness_max: f32,
     pub iridescence_texture: Option<TextureRef>,
     pub iridescence_thickness_texture: Option<TextureRef>,
+    /// KHR_materials_diffuse_transmission: the share (0: none) of the non-specular,
+    /// non-refracted light that passes to the other side as a Lambertian lobe of this colour
+    /// (not the base colour). Alpha of `diffuse_transmission_texture` multiplies the share,
+    /// RGB of the (sRGB) colour texture the colour.
+    pub diffuse_transmission: f32,
+    pub diffuse_transmission_color: Vec3,
+    pub diffuse_transmission_texture: Option<TextureRef>,
+    pub diffuse_transmission_color_texture: Option<TextureRef>,
 }
 
 impl Default for Material {
@@ -230,6 +238,10 @@ impl Default for Material {
             iridescence_thickness_max: 400.0,
             iridescence_texture: None,
             iridescence_thickness_texture: None,
+            diffuse_transmission: 0.0,
+            diffuse_transmission_color: Vec3::ONE,
+            diffuse_transmission_texture: None,
+            diffuse_transmission_color_texture: None,
         }
     }
 }

@@ -15,6 +15,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_pbrSpecularGlossiness",
     "KHR_materials_anisotropy",
     "KHR_materials_iridescence",
+    "KHR_materials_diffuse_transmission",
     "KHR_mesh_quantization",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",

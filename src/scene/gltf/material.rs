@@ -119,6 +119,15 @@ pub fn convert_material(
         texture(without_scale(json_info(irid.and_then(|c| c.get("iridescenceThicknessTexture")))));
     let aniso = m.extension_value("KHR_materials_anisotropy");
     let anisotropy_texture = texture(without_scale(json_info(aniso.and_then(|c| c.get("anisotropyTexture")))));
+    let dt = m.extension_value("KHR_materials_diffuse_transmission");
+    let diffuse_transmission_texture =
+        texture(without_scale(json_info(dt.and_then(|c| c.get("diffuseTransmissionTexture")))));
+    let diffuse_transmission_color_texture =
+        texture(without_scale(json_info(dt.and_then(|c| c.get("diffuseTransmissionColorTexture")))));
+    let diffuse_transmission_color = dt
+        .and_then(|v| v.get("diffuseTransmissionColorFactor"))
+        .and_then(|v| serde_json::from_value::<[f32; 3]>(v.clone()).ok())
+        .map_or(Vec3::ONE, Vec3::from);
     let material = Material {
         // glTF's factors are in [0, 1]; a hostile 1e20 would overflow a path's throughput.
         base_color: sane3(Vec3::new(r, g, b)).min(Vec3::ONE),
@@ -167,6 +176,10 @@ pub fn convert_material(
         iridescence_thickness_max: sane(number(irid, "iridescenceThicknessMaximum", 400.0), 0.0, 1e5, 400.0),
         iridescence_texture,
         iridescence_thickness_texture,
+        diffuse_transmission: sane(number(dt, "diffuseTransmissionFactor", 0.0), 0.0, 1.0, 0.0),
+        diffuse_transmission_color: sane3(diffuse_transmission_color).min(Vec3::ONE),
+        diffuse_transmission_texture,
+        diffuse_transmission_color_texture,
     };
     let material = match m.pbr_specular_glossiness() {
         Some(sg) => {
