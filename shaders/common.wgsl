@@ -23,6 +23,8 @@ override SHEEN: bool = true;
 override ANISOTROPY: bool = true;
 override IRIDESCENCE: bool = true;
 override DIFFUSE_TRANSMISSION: bool = true;
+// A refracting material disperses: paths pick a colour channel there (integrator.wgsl).
+override DISPERSION: bool = true;
 // The render accumulates AOVs (aov.wgsl); not a scene feature but a setting.
 override AOVS: bool = false;
 // Triangles carry COLOR_0 or TEXCOORD_1 (material.wgsl, triangle_uv and vertex_color).
@@ -141,7 +143,8 @@ struct Material {
     iridescence_thickness_min: f32,
     iridescence_thickness_max: f32,
     diffuse_transmission_color: vec3<f32>,
-    pad0: f32,
+    // KHR_materials_dispersion: 20 / Abbe number (0: none).
+    dispersion: f32,
     base_color_texture: TextureRef,
     metallic_roughness_texture: TextureRef,
     emissive_texture: TextureRef,

@@ -58,6 +58,9 @@ fn clamp_contribution(c: vec3<f32>, segments: u32) -> vec3<f32> {
     return select(c, c * (limit / sum), sum > limit);
 }
 
+// A path's colour channel before it meets a dispersive surface: all three.
+const ALL_CHANNELS: u32 = 3u;
+
 // Radiance arriving along a camera ray. Path depth counts segments (Mitsuba's max_depth).
 // With AOVS, what the ray saw of the first visible surface goes into `aov` (aov.wgsl).
 fn li(camera_ray: Ray, sampler: ptr<function, Sampler>, aov: ptr<function, AovSample>) -> vec3<f32> {
@@ -73,6 +76,7 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>, aov: ptr<function, AovSa
     // The AOVs look through Dirac surfaces, weighted by the path's own throughput there.
     var aov_open = AOVS;
     var aov_weight = vec3<f32>(1.0);
+    var channel = ALL_CHANNELS;
     loop {
         let hit = intersect_closest(ray);
         depth += 1u;
@@ -117,6 +121,19 @@ fn li(camera_ray: Ray, sampler: ptr<function, Sampler>, aov: ptr<function, AovSa
             break;
         }
 
+        // KHR_materials_dispersion: a refracting solid bends each colour its own way. From its
+        // first such surface on, the path follows one channel, chosen uniformly and weighted 3×
+        // (the others dropped): an unbiased estimate of every channel.
+        if (TRANSMISSION && DISPERSION && m.dispersion > 0.0 && m.transmission > 0.0
+            && (m.flags & MAT_THIN_WALLED) == 0u) {
+            if (channel == ALL_CHANNELS) {
+                channel = min(u32(sample_1d(sampler) * 3.0), 2u);
+                var mask = vec3<f32>(0.0);
+                mask[channel] = 3.0;
+                beta *= mask;
+            }
+            m.ior = dispersed_ior(m.ior, m.dispersion, channel);
+        }
         // Surfaces are two-sided: face both normals towards the incoming ray. `eta` is the
         // relative index of refraction for light crossing from the ray's side.
         let ng = select(ng_raw, -ng_raw, cos_hit > 0.0);

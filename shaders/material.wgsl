@@ -102,6 +102,17 @@ fn material_at(m: Material, uv: vec4<f32>, color: vec4<f32>) -> Material {
     return r;
 }
 
+// Wavelengths (nm) the colour channels stand for under KHR_materials_dispersion: Fraunhofer's
+// C, d and F lines, whose iors define the Abbe number.
+const CHANNEL_WAVELENGTHS = array<f32, 3>(656.3, 587.6, 486.1);
+
+// KHR_materials_dispersion's ior at colour channel `channel`: Cauchy's n(λ) = A + B/λ² through
+// `ior` at 587.6 nm with Abbe number 20 / dispersion, at least 1.
+fn dispersed_ior(ior: f32, dispersion: f32, channel: u32) -> f32 {
+    let l = CHANNEL_WAVELENGTHS[min(channel, 2u)];
+    return max(ior + (ior - 1.0) * (dispersion / 20.0) * (523655.0 / (l * l) - 1.5168), 1.0);
+}
+
 struct TangentFrame {
     t: vec3<f32>,
     b: vec3<f32>,

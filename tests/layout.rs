@@ -160,7 +160,7 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
                 iridescence_thickness_min,
                 iridescence_thickness_max,
                 diffuse_transmission_color,
-                pad0,
+                dispersion,
                 base_color_texture,
                 metallic_roughness_texture,
                 emissive_texture,
@@ -316,6 +316,7 @@ fn shared_constants_have_the_same_values() {
         ("SOLID_ANGLE_MIN", veach::cpu::spherical_triangle::SOLID_ANGLE_MIN as f64),
         ("SOLID_ANGLE_MAX", veach::cpu::spherical_triangle::SOLID_ANGLE_MAX as f64),
         ("ONE_MINUS_EPSILON", veach::cpu::light_tree::ONE_MINUS_EPSILON as f64),
+        ("ALL_CHANNELS", veach::cpu::integrator::ALL_CHANNELS as f64),
     ];
     let mut wrong = Vec::new();
     for (name, value) in rust {
@@ -342,6 +343,7 @@ fn every_override_the_host_sets_exists_in_the_kernel() {
         anisotropy: true,
         iridescence: true,
         diffuse_transmission: true,
+        dispersion: true,
         aovs: true,
         vertex_extras: true,
     };

@@ -720,6 +720,116 @@ fn diffuse_transmission_shows_its_colour_from_behind_on_the_gpu() {
     diffuse_transmission_on(Some(ctx));
 }
 
+/// KHR_materials_dispersion's ior at wavelength `l` (nm) from the extension's definitions:
+/// Cauchy's n = A + B/λ² through n_d at 587.6 nm with (n_d − 1)/(n_F − n_C) = 20 / dispersion
+/// (F = 486.1 nm, C = 656.3 nm), at least 1.
+fn cauchy_ior(nd: f64, dispersion: f64, l: f64) -> f64 {
+    if dispersion == 0.0 {
+        return nd;
+    }
+    let vd = 20.0 / dispersion;
+    let b = (nd - 1.0) / (vd * (486.1f64.powi(-2) - 656.3f64.powi(-2)));
+    let a = nd - b / (587.6 * 587.6);
+    (a + b / (l * l)).max(1.0)
+}
+
+/// Unpolarised Fresnel reflectance entering a dielectric of index n at incidence cos_i.
+fn fresnel_entering(cos_i: f64, n: f64) -> f64 {
+    let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (n * n)).sqrt();
+    let rs = (cos_i - n * cos_t) / (cos_i + n * cos_t);
+    let rp = (n * cos_i - cos_t) / (n * cos_i + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// KHR_materials_dispersion: an orthographic view through one tilted interface of smooth glass
+/// (60° incidence, ior 1.5, a solid: thickness 1) onto a lamp of radiance 1 covering x < −13.8
+/// of a plane 30 below (where the middle of the view lands through ior 1.5). Snell's law with each channel's Cauchy ior (red at 656.3 nm, green 587.6,
+/// blue 486.1) moves the lamp's edge in the image, so each channel's image mean is the lit
+/// fraction of the view times (1 − F)/n² (radiance entering a denser medium), all computed
+/// here. Without dispersion the three channels are the same sample for sample.
+fn dispersion_on(ctx: Option<GpuContext>) {
+    let tilt = 60f64.to_radians();
+    let (depth, half_width, edge) = (30.0f64, 2.0f64, -13.8f64);
+    let predict = |n: f64| {
+        // The refracted direction of (0, 0, −1) through the normal (sin, 0, cos).
+        let (cos_i, normal) = (tilt.cos(), glam::DVec3::new(tilt.sin(), 0.0, tilt.cos()));
+        let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (n * n)).sqrt();
+        let t = glam::DVec3::new(0.0, 0.0, -1.0) / n + (cos_i / n - cos_t) * normal;
+        let steps = 100_000;
+        let lit = (0..steps)
+            .filter(|&i| {
+                let x0 = -half_width + 2.0 * half_width * (i as f64 + 0.5) / steps as f64;
+                let z_hit = -x0 * tilt.tan();
+                x0 + t.x * (-depth - z_hit) / t.z < edge
+            })
+            .count();
+        lit as f64 / steps as f64 * (1.0 - fresnel_entering(cos_i, n)) / (n * n)
+    };
+    for dispersion in [0.0f32, 3.0] {
+        let d = dir(&format!("dispersion-{dispersion}-{}", engine(&ctx)));
+        let mut b = GltfBuilder::new(&d, "prism");
+        for e in ["KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_dispersion"] {
+            b.use_extension(e);
+        }
+        let glass = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0,
+            "roughnessFactor": 0}, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+            "KHR_materials_volume": {"thicknessFactor": 1.0}, "KHR_materials_dispersion": {"dispersion": dispersion}}}));
+        let lamp = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]},
+            "emissiveFactor": [1, 1, 1]}));
+        let pane = b.mesh(&MeshData::quad(-30.0, -30.0, 30.0, 30.0, 0.0, MeshData::UPRIGHT), glass);
+        let half = (tilt / 2.0) as f32;
+        b.node(json!({"mesh": pane, "rotation": [0.0, half.sin(), 0.0, half.cos()]}));
+        let backdrop =
+            b.mesh(&MeshData::quad(-100.0, -60.0, edge as f32, 60.0, -depth as f32, MeshData::UPRIGHT), lamp);
+        b.node(json!({"mesh": backdrop}));
+        b.orthographic_camera(0.25, 0.25, [0.0, 0.0, 5.0]);
+        let path = b.write();
+        let loaded = veach::load(&path, None).unwrap();
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+        assert_eq!(loaded.scene.materials[0].dispersion, dispersion);
+        let s = Settings { width: 64, height: 8, max_depth: 3, env_color: Some([0.0; 3]), ..Settings::default() };
+        let (backend, film) = render_on(&path, &s, 256, ctx.clone());
+        assert_eq!(film.nonfinite_samples(), 0, "{backend}");
+        let (mean, var) = film_stats(&film);
+        let n = mean.len() as f64;
+        let m: glam::DVec3 = mean.iter().map(|v| v.as_dvec3()).sum::<glam::DVec3>() / n;
+        let se = var.iter().map(|v| v.as_dvec3()).sum::<glam::DVec3>().max(glam::DVec3::ZERO).sqrt() / n;
+        let want =
+            glam::DVec3::from_array([656.3, 587.6, 486.1].map(|l| predict(cauchy_ior(1.5, dispersion as f64, l))));
+        eprintln!("dispersion {dispersion} {backend}: mean {m:.4} ± {se:.4}, predicted {want:.4}");
+        for c in 0..3 {
+            assert!(
+                (m[c] - want[c]).abs() <= 4.0 * se[c] + 1e-3,
+                "dispersion {dispersion} {backend}: mean {m} ± {se}, predicted {want}"
+            );
+        }
+        if dispersion == 0.0 {
+            assert!(mean.iter().all(|v| v.x == v.y && v.y == v.z), "{backend}: colour without dispersion");
+        } else {
+            // The test tells dispersion from none: red and blue are far apart for its error.
+            assert!((want.x - want.z).abs() > 10.0 * (se.x + se.z), "predicted {want}, error {se}");
+        }
+        if ctx.is_some() {
+            let (_, cpu) = render_on(&path, &s, 256, None);
+            let (cm, cv) = film_stats(&cpu);
+            let a = agreement(&mean, &var, &cm, &cv);
+            assert!(a.mean_z.abs().max_element() < 5.0, "dispersion {dispersion}: GPU vs CPU {a:?}");
+        }
+    }
+}
+
+#[test]
+fn dispersion_moves_each_colour_by_its_own_ior() {
+    dispersion_on(None);
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn dispersion_moves_each_colour_by_its_own_ior_on_the_gpu() {
+    let Some(ctx) = gpu("dispersion_moves_each_colour_by_its_own_ior_on_the_gpu") else { return };
+    dispersion_on(Some(ctx));
+}
+
 fn glass_furnace_on(ctx: Option<GpuContext>) {
     // Environment 1 everywhere: every pixel's expected value is 1 for smooth glass (Fresnel
     // splits, refraction's 1/η² and η² cancel on the way in and out). Rough glass may lose

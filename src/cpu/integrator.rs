@@ -8,7 +8,9 @@ use super::frame::{Frame, frame_from_normal, from_local, to_local};
 use super::instance::world_triangle;
 use super::light_tree::LightContext;
 use super::lights::{LightSample, light_pdf, sample_light, sample_punctual};
-use super::material::{anisotropy_direction, coat_normal, material_at, shading_normal, triangle_uv, vertex_color};
+use super::material::{
+    anisotropy_direction, coat_normal, dispersed_ior, material_at, shading_normal, triangle_uv, vertex_color,
+};
 use super::mis::mis_weight;
 use super::sampler::{Sampler, sample_1d, sample_2d};
 use crate::Strategy;
@@ -16,6 +18,9 @@ use crate::aov::AovSample;
 use crate::packed::{MAT_THIN_WALLED, Material, NO_TEXTURE, PackedScene, TRI_MIRRORED};
 use crate::params::{LIGHT_SAMPLER_TREE, Params};
 use glam::{UVec2, Vec3};
+
+/// A path's colour channel before it meets a dispersive surface: all three.
+pub const ALL_CHANNELS: u32 = 3;
 
 fn same_side(wi: Vec3, ng: Vec3, wi_local: Vec3) -> bool {
     (wi.dot(ng) > 0.0) == (wi_local.z > 0.0)
@@ -84,6 +89,7 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
     // The AOVs look through Dirac surfaces, weighted by the path's own throughput there.
     let mut aov_open = params.aov_base > 0;
     let mut aov_weight = Vec3::ONE;
+    let mut channel = ALL_CHANNELS;
     loop {
         let hit = intersect_closest(scene, &ray);
         depth += 1;
@@ -137,6 +143,19 @@ pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut S
             break;
         }
 
+        // KHR_materials_dispersion: a refracting solid bends each colour its own way. From its
+        // first such surface on, the path follows one channel, chosen uniformly and weighted
+        // 3× (the others dropped): an unbiased estimate of every channel.
+        if mat.dispersion > 0.0 && mat.transmission > 0.0 && mat.flags & MAT_THIN_WALLED == 0 {
+            if channel == ALL_CHANNELS {
+                channel = ((sample_1d(sampler) * 3.0) as u32).min(2);
+                let mut mask = Vec3::ZERO;
+                mask[channel as usize] = 3.0;
+                beta *= mask;
+            }
+            mat.ior = dispersed_ior(mat.ior, mat.dispersion, channel);
+        }
+        let m = &mat;
         let ng = if cos_hit > 0.0 { -ng_raw } else { ng_raw };
         // A thin wall has air on both sides.
         let eta = if cos_hit < 0.0 || m.flags & MAT_THIN_WALLED != 0 { m.ior } else { 1.0 / m.ior };

@@ -107,6 +107,19 @@ pub fn material_at(scene: &PackedScene, m: &Material, uv: Vec4, color: Vec4) -> 
     r
 }
 
+/// Wavelengths (nm) the colour channels stand for under KHR_materials_dispersion: Fraunhofer's
+/// C, d and F lines, whose iors define the Abbe number (the extension's own per-channel
+/// example spreads red and blue by the same (n_F − n_C)/2 about green).
+pub const CHANNEL_WAVELENGTHS: [f32; 3] = [656.3, 587.6, 486.1];
+
+/// KHR_materials_dispersion's ior at colour channel `channel`: Cauchy's n(λ) = A + B/λ²
+/// through `ior` at 587.6 nm with Abbe number 20 / `dispersion`, at least 1. Twin of
+/// `dispersed_ior`.
+pub fn dispersed_ior(ior: f32, dispersion: f32, channel: u32) -> f32 {
+    let l = CHANNEL_WAVELENGTHS[channel.min(2) as usize];
+    (ior + (ior - 1.0) * (dispersion / 20.0) * (523655.0 / (l * l) - 1.5168)).max(1.0)
+}
+
 /// The tangent frame at (u, v) around the unit normal `n`: the interpolated vertex tangent
 /// (to world space with instancing) Gram-Schmidt'd against n, and the bitangent n × t times
 /// the handedness of the nearest vertex (all three agree within a UV island), flipped by

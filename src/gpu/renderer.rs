@@ -24,7 +24,7 @@ pub struct GpuRenderer {
     #[cfg(feature = "bench")]
     pub(super) variant: shaders::Geometry,
     /// The override constants the pipelines were made with (the scene's features, AOVs).
-    pub(super) constants: [(&'static str, f64); 12],
+    pub(super) constants: [(&'static str, f64); 13],
     /// `trace_rays` pipelines by TRACE_KIND, built on first use (by `veach bench` only).
     #[cfg(feature = "bench")]
     pub(super) trace_pipelines: [Option<wgpu::ComputePipeline>; 3],

@@ -18,6 +18,8 @@ pub struct Features {
     pub iridescence: bool,
     /// KHR_materials_diffuse_transmission.
     pub diffuse_transmission: bool,
+    /// KHR_materials_dispersion on a refracting material.
+    pub dispersion: bool,
     /// The render accumulates AOVs (a setting, not a property of the scene: false here, set
     /// by the engine).
     pub aovs: bool,
@@ -27,7 +29,7 @@ pub struct Features {
 
 impl Features {
     /// The pipeline constants of `shaders/common.wgsl`.
-    pub fn constants(&self) -> [(&'static str, f64); 12] {
+    pub fn constants(&self) -> [(&'static str, f64); 13] {
         let f = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("ALPHA_TEST", f(self.alpha_test)),
@@ -40,6 +42,7 @@ impl Features {
             ("ANISOTROPY", f(self.anisotropy)),
             ("IRIDESCENCE", f(self.iridescence)),
             ("DIFFUSE_TRANSMISSION", f(self.diffuse_transmission)),
+            ("DISPERSION", f(self.dispersion)),
             ("AOVS", f(self.aovs)),
             ("VERTEX_EXTRAS", f(self.vertex_extras)),
         ]
@@ -82,6 +85,7 @@ impl PackedScene {
             anisotropy: self.materials.iter().any(|m| m.anisotropy > 0.0),
             iridescence: self.materials.iter().any(|m| m.iridescence > 0.0),
             diffuse_transmission: self.materials.iter().any(|m| m.diffuse_transmission > 0.0),
+            dispersion: self.materials.iter().any(|m| m.dispersion > 0.0 && m.transmission > 0.0),
             aovs: false,
             vertex_extras: self.extras_base > 0,
         }

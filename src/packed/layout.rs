@@ -138,7 +138,8 @@ pub struct Material {
     pub iridescence_thickness_max: f32,
     /// The colour of the diffusely transmitted light.
     pub diffuse_transmission_color: [f32; 3],
-    pub pad0: f32,
+    /// KHR_materials_dispersion: 20 / Abbe number (0: none).
+    pub dispersion: f32,
     pub base_color_texture: TextureRef,
     pub metallic_roughness_texture: TextureRef,
     pub emissive_texture: TextureRef,

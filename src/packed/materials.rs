@@ -64,7 +64,7 @@ pub fn pack_material(m: &Material, atlas: &[Placement]) -> PackedMaterial {
         iridescence_thickness_min: m.iridescence_thickness_min,
         iridescence_thickness_max: m.iridescence_thickness_max,
         diffuse_transmission_color: m.diffuse_transmission_color.into(),
-        pad0: 0.0,
+        dispersion: m.dispersion,
         base_color_texture: pack_texture_ref(m.base_color_texture, true),
         metallic_roughness_texture: pack_texture_ref(m.metallic_roughness_texture, false),
         emissive_texture: pack_texture_ref(m.emissive_texture, true),

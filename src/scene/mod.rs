@@ -191,6 +191,9 @@ pub struct Material {
     pub diffuse_transmission_color: Vec3,
     pub diffuse_transmission_texture: Option<TextureRef>,
     pub diffuse_transmission_color_texture: Option<TextureRef>,
+    /// KHR_materials_dispersion: 20 / Abbe number (0: none); the ior is then Cauchy's fit
+    /// through `ior` at 587.6 nm, per colour channel (refracting solids only).
+    pub dispersion: f32,
 }
 
 impl Default for Material {
@@ -242,6 +245,7 @@ impl Default for Material {
             diffuse_transmission_color: Vec3::ONE,
             diffuse_transmission_texture: None,
             diffuse_transmission_color_texture: None,
+            dispersion: 0.0,
         }
     }
 }

@@ -16,6 +16,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_anisotropy",
     "KHR_materials_iridescence",
     "KHR_materials_diffuse_transmission",
+    "KHR_materials_dispersion",
     "KHR_mesh_quantization",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
@@ -28,7 +29,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
 
 /// Extensions veach knows and ignores for now; files that merely use them render, with one
 /// warning each.
-const KNOWN_UNIMPLEMENTED: &[&str] = &["KHR_materials_dispersion"];
+const KNOWN_UNIMPLEMENTED: &[&str] = &[];
 
 /// Required extensions veach cannot honour are an error naming them; used ones it does not
 /// know get one warning each.

@@ -180,6 +180,7 @@ pub fn convert_material(
         diffuse_transmission_color: sane3(diffuse_transmission_color).min(Vec3::ONE),
         diffuse_transmission_texture,
         diffuse_transmission_color_texture,
+        dispersion: sane(number(m.extension_value("KHR_materials_dispersion"), "dispersion", 0.0), 0.0, 100.0, 0.0),
     };
     let material = match m.pbr_specular_glossiness() {
         Some(sg) => {
