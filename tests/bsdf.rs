@@ -502,3 +502,103 @@ fn diffuse_transmission_moves_its_share_to_the_other_side() {
         );
     }
 }
+
+/// Mitsuba 3's `principled` BSDF with metallic 1 is the same lobe as glTF's metal under
+/// KHR_materials_anisotropy: GGX with Schlick's Fresnel toward the base colour, its α along
+/// and across the tangent from Disney's aspect (tests/data/principled.json, made by
+/// bench/principled_reference.py: Mitsuba's own `eval` on 144 view/light pairs per case). The
+/// parameterisations map exactly (veach: α_b = roughness², α_t = mix(α_b, 1, strength²)). The
+/// one model difference is masking-shadowing: Mitsuba's is separable, G1(v)·G1(l), veach's
+/// height-correlated, 1/(1 + Λ(v) + Λ(l)); with that factor (computed here from Λ's
+/// definition) taken out the two agree to 0.01 %, and veach is never below Mitsuba before.
+#[test]
+fn metal_and_anisotropy_match_mitsubas_principled_bsdf() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/principled.json");
+    let data: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let v3 = |v: &serde_json::Value| {
+        Vec3::new(v[0].as_f64().unwrap() as f32, v[1].as_f64().unwrap() as f32, v[2].as_f64().unwrap() as f32)
+    };
+    let base = v3(&data["base_color"]);
+    let cases = data["cases"].as_array().unwrap();
+    assert_eq!(cases.len(), 3);
+    for case in cases {
+        let name = case["name"].as_str().unwrap();
+        let (ax, ay) = (case["alpha_x"].as_f64().unwrap(), case["alpha_y"].as_f64().unwrap());
+        let strength = ((ax - ay) / (1.0 - ay)).max(0.0).sqrt() as f32;
+        let m = pack_material(
+            &Material {
+                base_color: base,
+                metallic: 1.0,
+                roughness: (ay.sqrt()) as f32,
+                anisotropy: strength,
+                ..Material::default()
+            },
+            &[],
+        );
+        let lambda = |w: Vec3| {
+            let (x, y, z) = (w.x as f64, w.y as f64, w.z as f64);
+            0.5 * ((1.0 + (ax * ax * x * x + ay * ay * y * y) / (z * z)).sqrt() - 1.0)
+        };
+        let samples = case["samples"].as_array().unwrap();
+        assert_eq!(samples.len(), 144, "{name}");
+        let mut worst = 0.0f64;
+        for s in samples {
+            let (view, light, want) = (v3(&s["view"]), v3(&s["light"]), v3(&s["f_cos"]).as_dvec3());
+            let got = (bsdf_eval(&m, view, light, 1.5) * light.z).as_dvec3();
+            let (lv, ll) = (lambda(view), lambda(light));
+            let separable_over_correlated = (1.0 + lv + ll) / ((1.0 + lv) * (1.0 + ll));
+            let explained = got * separable_over_correlated;
+            for c in 0..3 {
+                assert!(
+                    got[c] >= want[c] * (1.0 - 1e-4) - 1e-7,
+                    "{name} v={view} l={light}: veach {got} below Mitsuba {want}"
+                );
+                let err = (explained[c] - want[c]).abs();
+                assert!(
+                    err <= 1e-3 * want[c] + 1e-6,
+                    "{name} v={view} l={light}: veach {got} (×G ratio {explained}) vs Mitsuba {want}"
+                );
+                worst = worst.max(err / want[c].max(1e-6));
+            }
+        }
+        eprintln!("{name}: worst relative difference {worst:.2e} after the masking factor");
+    }
+}
+
+/// Below the surface Mitsuba 3's `principledthin` (eta 1: no specular; Disney's diff_trans =
+/// 2 × the share) is KHR_materials_diffuse_transmission's Lambertian lobe with the base
+/// colour as its colour (tests/data/principled.json): veach's transmitted f·|cos| is the same
+/// to 0.01 %. (Above the surface principledthin has Disney's retro-reflective diffuse, which
+/// glTF does not model.)
+#[test]
+fn diffuse_transmission_matches_mitsubas_thin_principled_bsdf() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/principled.json");
+    let data: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let v3 = |v: &serde_json::Value| {
+        Vec3::new(v[0].as_f64().unwrap() as f32, v[1].as_f64().unwrap() as f32, v[2].as_f64().unwrap() as f32)
+    };
+    let base = v3(&data["base_color"]);
+    let dt = &data["diffuse_transmission"];
+    let share = dt["share"].as_f64().unwrap() as f32;
+    let m = pack_material(
+        &translucent(
+            Material { base_color: base, metallic: 0.0, roughness: 0.5, specular_factor: 0.0, ..Material::default() },
+            share,
+            base,
+        ),
+        &[],
+    );
+    let samples = dt["samples"].as_array().unwrap();
+    assert_eq!(samples.len(), 36);
+    for s in samples {
+        let (view, light, want) = (v3(&s["view"]), v3(&s["light"]), v3(&s["f_cos"]).as_dvec3());
+        assert!(light.z < 0.0);
+        let got = (bsdf_eval(&m, view, light, 1.5) * -light.z).as_dvec3();
+        for c in 0..3 {
+            assert!(
+                (got[c] - want[c]).abs() <= 1e-4 * want[c] + 1e-7,
+                "v={view} l={light}: veach {got} vs Mitsuba {want}"
+            );
+        }
+    }
+}
