@@ -503,6 +503,17 @@ fn diffuse_transmission_moves_its_share_to_the_other_side() {
     }
 }
 
+/// tests/data/principled.json: Mitsuba 3's own BSDF values (bench/principled_reference.py).
+fn principled_reference() -> serde_json::Value {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/principled.json");
+    serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap()
+}
+
+/// A JSON array of three numbers.
+fn v3(v: &serde_json::Value) -> Vec3 {
+    Vec3::new(v[0].as_f64().unwrap() as f32, v[1].as_f64().unwrap() as f32, v[2].as_f64().unwrap() as f32)
+}
+
 /// Mitsuba 3's `principled` BSDF with metallic 1 is the same lobe as glTF's metal under
 /// KHR_materials_anisotropy: GGX with Schlick's Fresnel toward the base colour, its α along
 /// and across the tangent from Disney's aspect (tests/data/principled.json, made by
@@ -513,11 +524,7 @@ fn diffuse_transmission_moves_its_share_to_the_other_side() {
 /// definition) taken out the two agree to 0.01 %, and veach is never below Mitsuba before.
 #[test]
 fn metal_and_anisotropy_match_mitsubas_principled_bsdf() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/principled.json");
-    let data: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
-    let v3 = |v: &serde_json::Value| {
-        Vec3::new(v[0].as_f64().unwrap() as f32, v[1].as_f64().unwrap() as f32, v[2].as_f64().unwrap() as f32)
-    };
+    let data = principled_reference();
     let base = v3(&data["base_color"]);
     let cases = data["cases"].as_array().unwrap();
     assert_eq!(cases.len(), 3);
@@ -572,11 +579,7 @@ fn metal_and_anisotropy_match_mitsubas_principled_bsdf() {
 /// glTF does not model.)
 #[test]
 fn diffuse_transmission_matches_mitsubas_thin_principled_bsdf() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/principled.json");
-    let data: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
-    let v3 = |v: &serde_json::Value| {
-        Vec3::new(v[0].as_f64().unwrap() as f32, v[1].as_f64().unwrap() as f32, v[2].as_f64().unwrap() as f32)
-    };
+    let data = principled_reference();
     let base = v3(&data["base_color"]);
     let dt = &data["diffuse_transmission"];
     let share = dt["share"].as_f64().unwrap() as f32;

@@ -42,6 +42,14 @@ fn render_on(path: &Path, settings: &Settings, spp: u32, ctx: Option<GpuContext>
     (backend, r.film().unwrap())
 }
 
+/// The GPU's film agrees with the CPU reference's pixel by pixel within 5 standard errors.
+fn assert_films_agree(what: &str, gpu: &Film, cpu: &Film) {
+    let (gm, gv) = film_stats(gpu);
+    let (cm, cv) = film_stats(cpu);
+    let a = agreement(&gm, &gv, &cm, &cv);
+    assert!(a.mean_z.abs().max_element() < 5.0, "{what}: GPU vs CPU {a:?}");
+}
+
 fn settings(width: u32, height: u32, max_depth: u32) -> Settings {
     Settings { width, height, max_depth, env_color: Some([0.0; 3]), ..Settings::default() }
 }
@@ -505,11 +513,7 @@ fn layered_materials_on(ctx: Option<GpuContext>) {
         assert!(m <= 1.0 + 4.0 * se + 1e-4, "{name} {backend}: energy gain, mean {m} ± {se}");
         assert!(m >= min_mean - 4.0 * se, "{name} {backend}: mean {m} ± {se} below {min_mean}");
         if ctx.is_some() {
-            let (_, cpu) = render_on(&path, &s, 32, None);
-            let (cm, cv) = film_stats(&cpu);
-            let (gm, gv) = film_stats(&film);
-            let a = agreement(&gm, &gv, &cm, &cv);
-            assert!(a.mean_z.abs().max_element() < 5.0, "{name}: GPU vs CPU {a:?}");
+            assert_films_agree(name, &film, &render_on(&path, &s, 32, None).1);
         }
     }
 }
@@ -686,10 +690,7 @@ fn diffuse_transmission_on(ctx: Option<GpuContext>) {
         assert!((m[c] - want[c]).abs() <= 4.0 * se[c] + 1e-3, "{backend}: mean {m} ± {se}, want {want}");
     }
     if ctx.is_some() {
-        let (_, cpu) = render_on(&path, &s, 16, None);
-        let (cm, cv) = film_stats(&cpu);
-        let a = agreement(&mean, &var, &cm, &cv);
-        assert!(a.mean_z.abs().max_element() < 5.0, "GPU vs CPU {a:?}");
+        assert_films_agree("diffuse transmission", &film, &render_on(&path, &s, 16, None).1);
     } else {
         // The textures: the share in alpha, the colour in sRGB RGB.
         let d = dir("diffuse-transmission-textures");
@@ -810,10 +811,7 @@ fn dispersion_on(ctx: Option<GpuContext>) {
             assert!((want.x - want.z).abs() > 10.0 * (se.x + se.z), "predicted {want}, error {se}");
         }
         if ctx.is_some() {
-            let (_, cpu) = render_on(&path, &s, 256, None);
-            let (cm, cv) = film_stats(&cpu);
-            let a = agreement(&mean, &var, &cm, &cv);
-            assert!(a.mean_z.abs().max_element() < 5.0, "dispersion {dispersion}: GPU vs CPU {a:?}");
+            assert_films_agree(&format!("dispersion {dispersion}"), &film, &render_on(&path, &s, 256, None).1);
         }
     }
 }
@@ -844,11 +842,7 @@ fn glass_furnace_on(ctx: Option<GpuContext>) {
         assert!(m <= 1.0 + 4.0 * se + 1e-4, "glass r={roughness} {backend}: energy gain, mean {m} ± {se}");
         assert!(m >= min_mean - 4.0 * se, "glass r={roughness} {backend}: mean {m} ± {se} below {min_mean}");
         if ctx.is_some() {
-            let (_, cpu) = render_on(&path, &s, 32, None);
-            let (cm, cv) = film_stats(&cpu);
-            let (gm, gv) = film_stats(&film);
-            let a = agreement(&gm, &gv, &cm, &cv);
-            assert!(a.mean_z.abs().max_element() < 5.0, "glass r={roughness}: GPU vs CPU {a:?}");
+            assert_films_agree(&format!("glass r={roughness}"), &film, &render_on(&path, &s, 32, None).1);
         }
     }
 }
@@ -942,10 +936,7 @@ fn anisotropy_on(ctx: Option<GpuContext>) {
         let (_, film) = render_on(&path, &settings(48, 48, 2), 16, None);
         if ctx.is_some() {
             let (_, gpu) = render_on(&path, &settings(48, 48, 2), 16, ctx.clone());
-            let (cm, cv) = film_stats(&film);
-            let (gm, gv) = film_stats(&gpu);
-            let a = agreement(&gm, &gv, &cm, &cv);
-            assert!(a.mean_z.abs().max_element() < 5.0, "rotation {rotation}: GPU vs CPU {a:?}");
+            assert_films_agree(&format!("rotation {rotation}"), &gpu, &film);
         }
         // Second moments of the highlight about the image centre, weighted by luminance.
         let (mut sx, mut sy, mut total) = (0.0f64, 0.0f64, 0.0f64);

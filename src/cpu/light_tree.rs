@@ -2,9 +2,9 @@
 //! root with one random number, and the exact probability of choosing an emitter.
 
 use super::lights::light_entry;
-use crate::packed::{LIGHT_LEAF, LIGHT_NODE_ROWS, LIGHT_TWO_SIDED, PackedScene};
+use crate::packed::{LIGHT_LEAF, LIGHT_NODE_ROWS, LIGHT_TWO_SIDED, LightPair, PackedScene};
 use crate::params::Params;
-use glam::{Vec2, Vec3};
+use glam::{BVec4A, Vec2, Vec3, Vec4};
 
 /// What light selection knows of the shading point. A BSDF hit on an emitter recomputes the
 /// selection probability with the context of the vertex the ray left, bit for bit the one
@@ -139,83 +139,147 @@ pub fn child_share(i: Vec2, total: Vec2) -> f32 {
     0.5 * (i.x / total.x + i.y / total.y)
 }
 
-/// The children of interior node `node` (stored at index `at`) with their importances, or
-/// None at a dead end (neither child can contribute). Both walks step through this.
-struct Children {
-    c0: LightNode,
-    c1: LightNode,
-    i0: Vec2,
-    i1: Vec2,
-    total: Vec2,
+/// Two floats in the low lanes of a vector (the high lanes zero: no power, never chosen).
+#[inline(always)]
+fn lanes(a: [f32; 2]) -> Vec4 {
+    Vec4::new(a[0], a[1], 0.0, 0.0)
 }
 
-fn children(scene: &PackedScene, params: &Params, ctx: &LightContext, node: &LightNode, at: u32) -> Option<Children> {
-    let c0 = load_light_node(scene, params, at + 1);
-    let c1 = load_light_node(scene, params, node.index);
-    let (i0, i1) = (child_importance(scene, params, ctx, &c0), child_importance(scene, params, ctx, &c1));
-    let total = i0 + i1;
+#[inline(always)]
+fn dot3(a: [Vec4; 3], b: [Vec4; 3]) -> Vec4 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// `node_importance` of both children of a pair at once, lane by lane the same operations in
+/// the same order (so the same bits: SSE's min, max, sqrt and division round as the scalar
+/// ones do, and take the same operand on NaN): far estimates in `.0`, near in `.1`, lanes 0
+/// and 1.
+#[inline(always)]
+fn pair_importance(ctx: &LightContext, pair: &LightPair) -> (Vec4, Vec4) {
+    let zero = Vec4::ZERO;
+    let phi = lanes(pair.phi);
+    let p = [Vec4::splat(ctx.point.x), Vec4::splat(ctx.point.y), Vec4::splat(ctx.point.z)];
+    let n = [Vec4::splat(ctx.normal.x), Vec4::splat(ctx.normal.y), Vec4::splat(ctx.normal.z)];
+    let lo = pair.lo.map(lanes);
+    let hi = pair.hi.map(lanes);
+    let pc = [0, 1, 2].map(|k| Vec4::splat(0.5) * (lo[k] + hi[k]));
+    let half = [0, 1, 2].map(|k| Vec4::splat(0.5) * (hi[k] - lo[k]));
+    let mut dead = phi.cmple(zero);
+    if ctx.reflect_only {
+        let below = dot3([0, 1, 2].map(|k| pc[k] - p[k]), n) + dot3(half, n.map(Vec4::abs));
+        dead |= below.cmple(zero);
+    }
+    let r2 = dot3(half, half);
+    let to_p = [0, 1, 2].map(|k| p[k] - pc[k]);
+    let dist2 = dot3(to_p, to_p);
+    let outside = [0, 1, 2].map(|k| p[k] - p[k].max(lo[k]).min(hi[k]));
+    let tiny = Vec4::splat(1e-20);
+    let d2_far = dist2.max(r2).max(tiny);
+    let d2_near = dot3(outside, outside).max(Vec4::splat(0.25) * r2).max(tiny);
+    let inside = dist2.cmple(r2);
+    let inv_d = Vec4::ONE / dist2.sqrt();
+    let wi = to_p.map(|c| c * inv_d);
+    let mut cos_w = dot3(pair.axis.map(lanes), wi);
+    let two_sided = pair.next.map(|x| x & LIGHT_TWO_SIDED != 0);
+    cos_w = Vec4::select(BVec4A::new(two_sided[0], two_sided[1], false, false), cos_w.abs(), cos_w);
+    let safe_sqrt = |x: Vec4| x.max(zero).sqrt();
+    let cos_sub = |sa: Vec4, ca: Vec4, sb: Vec4, cb: Vec4| Vec4::select(ca.cmpgt(cb), Vec4::ONE, ca * cb + sa * sb);
+    let sin_sub = |sa: Vec4, ca: Vec4, sb: Vec4, cb: Vec4| Vec4::select(ca.cmpgt(cb), zero, sa * cb - ca * sb);
+    let sin_w = safe_sqrt(Vec4::ONE - cos_w * cos_w);
+    let sin2_b = r2 * (inv_d * inv_d);
+    let cos_b = safe_sqrt(Vec4::ONE - sin2_b);
+    let sin_b = sin2_b.sqrt();
+    let (sin_o, cos_o) = (lanes(pair.sin_o), lanes(pair.cos_o));
+    let cos_x = cos_sub(sin_w, cos_w, sin_o, cos_o);
+    let sin_x = sin_sub(sin_w, cos_w, sin_o, cos_o);
+    let cos_p = cos_sub(sin_x, cos_x, sin_b, cos_b);
+    let culled = cos_p.cmple(lanes(pair.cos_e));
+    let cos_i = dot3(wi, n).abs();
+    let sin_i = safe_sqrt(Vec4::ONE - cos_i * cos_i);
+    let cos_pi = cos_sub(sin_i, cos_i, sin_b, cos_b);
+    let lit = phi * cos_p * cos_pi;
+    let (mut far, mut near) = ((lit / d2_far).max(zero), (lit / d2_near).max(zero));
+    far = Vec4::select(culled, zero, far);
+    near = Vec4::select(culled, zero, near);
+    far = Vec4::select(inside, phi / d2_far, far);
+    near = Vec4::select(inside, phi / d2_near, near);
+    (Vec4::select(dead, zero, far), Vec4::select(dead, zero, near))
+}
+
+/// The children of a pair with their importances (`child_importance` of each: the pair's
+/// lanes, then the plane test of one-sided leaf triangles), or None at a dead end (neither
+/// child can contribute). Both walks step through this.
+#[inline(always)]
+fn children(scene: &PackedScene, params: &Params, ctx: &LightContext, pair: &LightPair) -> Option<[Vec2; 3]> {
+    let (far, near) = pair_importance(ctx, pair);
+    let mut i = [Vec2::new(far.x, near.x), Vec2::new(far.y, near.y)];
+    for (lane, imp) in i.iter_mut().enumerate() {
+        let next = pair.next[lane];
+        let emitter = next & !(LIGHT_LEAF | LIGHT_TWO_SIDED);
+        if imp.x > 0.0 && next & (LIGHT_LEAF | LIGHT_TWO_SIDED) == LIGHT_LEAF && emitter < params.light_count {
+            let [p0, n] = scene.light_planes[emitter as usize];
+            if n.dot(ctx.point - p0) <= 0.0 {
+                *imp = Vec2::ZERO;
+            }
+        }
+    }
+    let total = i[0] + i[1];
     if total.x.is_nan() || total.x <= 0.0 {
         return None;
     }
-    Some(Children { c0, c1, i0, i1, total })
+    Some([i[0], i[1], total])
 }
 
 /// Chooses an emitter: at each node a child by its share, `u` rescaled into the chosen
 /// interval. Returns (emitter, probability); probability 0: nothing to choose (every emitter
 /// of the subtree reached provably contributes nothing).
 pub fn sample_light_tree(scene: &PackedScene, params: &Params, ctx: &LightContext, u: f32) -> (u32, f32) {
-    let mut node = load_light_node(scene, params, 0);
-    if node.leaf {
-        return (node.index, if child_importance(scene, params, ctx, &node).x > 0.0 { 1.0 } else { 0.0 });
+    let root = load_light_node(scene, params, 0);
+    if root.leaf {
+        return (root.index, if child_importance(scene, params, ctx, &root).x > 0.0 { 1.0 } else { 0.0 });
     }
-    let mut at = 0u32;
+    let mut pair = &scene.light_pairs[0];
     let mut u = u;
     let mut pmf = 1.0f32;
     loop {
-        let Some(ch) = children(scene, params, ctx, &node, at) else { return (0, 0.0) };
-        let p0 = child_share(ch.i0, ch.total);
-        if u < p0 {
+        let Some([i0, i1, total]) = children(scene, params, ctx, pair) else { return (0, 0.0) };
+        let p0 = child_share(i0, total);
+        let next = if u < p0 {
             u = (u / p0).min(ONE_MINUS_EPSILON);
             pmf *= p0;
-            at += 1;
-            node = ch.c0;
+            pair.next[0]
         } else {
             u = ((u - p0) / (1.0 - p0)).min(ONE_MINUS_EPSILON);
-            pmf *= child_share(ch.i1, ch.total);
-            at = node.index;
-            node = ch.c1;
+            pmf *= child_share(i1, total);
+            pair.next[1]
+        };
+        if next & LIGHT_LEAF != 0 {
+            return (next & !(LIGHT_LEAF | LIGHT_TWO_SIDED), pmf);
         }
-        if node.leaf {
-            return (node.index, pmf);
-        }
+        pair = &scene.light_pairs[(next & !LIGHT_TWO_SIDED) as usize];
     }
 }
 
 /// The probability that `sample_light_tree` chooses `emitter` from `ctx`: the walk down its
 /// trail, multiplying the same shares in the same order.
 pub fn light_tree_pmf(scene: &PackedScene, params: &Params, ctx: &LightContext, emitter: u32) -> f32 {
-    let mut node = load_light_node(scene, params, 0);
-    if node.leaf {
-        return if child_importance(scene, params, ctx, &node).x > 0.0 { 1.0 } else { 0.0 };
+    let root = load_light_node(scene, params, 0);
+    if root.leaf {
+        return if child_importance(scene, params, ctx, &root).x > 0.0 { 1.0 } else { 0.0 };
     }
     let row = scene.light_rows[(params.trail_base + emitter / 4) as usize];
     let mut trail = row[(emitter % 4) as usize];
-    let mut at = 0u32;
+    let mut pair = &scene.light_pairs[0];
     let mut pmf = 1.0f32;
     loop {
-        let Some(ch) = children(scene, params, ctx, &node, at) else { return 0.0 };
-        if trail & 1 == 0 {
-            pmf *= child_share(ch.i0, ch.total);
-            at += 1;
-            node = ch.c0;
-        } else {
-            pmf *= child_share(ch.i1, ch.total);
-            at = node.index;
-            node = ch.c1;
-        }
+        let Some([i0, i1, total]) = children(scene, params, ctx, pair) else { return 0.0 };
+        let lane = (trail & 1) as usize;
+        pmf *= child_share(if lane == 0 { i0 } else { i1 }, total);
+        let next = pair.next[lane];
         trail >>= 1;
-        if node.leaf {
+        if next & LIGHT_LEAF != 0 {
             return pmf;
         }
+        pair = &scene.light_pairs[(next & !LIGHT_TWO_SIDED) as usize];
     }
 }

@@ -86,3 +86,63 @@ pub fn pack_light_tree(emitters: &[LightBounds]) -> PackedLightTree {
     }
     PackedLightTree { rows, nodes: nodes.len(), trail_offset, depth, build_seconds }
 }
+
+/// The two children of an interior node of the light tree, decoded for the CPU engine, which
+/// evaluates both children's importance at once in SIMD lanes (lane 0: the first child, at the
+/// parent's index + 1; lane 1: the second). The values are the node rows' own bits (the axis
+/// decoded as the kernel decodes it), so both twins still compute the same numbers.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(8))]
+pub struct LightPair {
+    pub lo: [[f32; 2]; 3],
+    pub hi: [[f32; 2]; 3],
+    pub axis: [[f32; 2]; 3],
+    pub phi: [f32; 2],
+    pub cos_o: [f32; 2],
+    pub sin_o: [f32; 2],
+    pub cos_e: [f32; 2],
+    /// Per child: a leaf's emitter | LIGHT_LEAF | LIGHT_TWO_SIDED, or an interior child's
+    /// own pair index | LIGHT_TWO_SIDED.
+    pub next: [u32; 2],
+}
+
+/// The pairs of the tree whose node rows are `rows` (`nodes` of them, axes decoded in
+/// `axes`), indexed so that the root's children are pair 0; empty when the root is a leaf.
+pub fn light_pairs(rows: &[[u32; 4]], nodes: usize, axes: &[Vec3]) -> Vec<LightPair> {
+    let is_leaf = |n: usize| rows[3 * n + 2][2] & LIGHT_LEAF != 0;
+    if nodes == 0 || is_leaf(0) {
+        return Vec::new();
+    }
+    // Interior nodes in index order: pair k holds the children of the k-th interior node.
+    let mut ordinal = vec![u32::MAX; nodes];
+    let mut interior = Vec::new();
+    for (n, o) in ordinal.iter_mut().enumerate() {
+        if !is_leaf(n) {
+            *o = interior.len() as u32;
+            interior.push(n);
+        }
+    }
+    let flags = LIGHT_LEAF | LIGHT_TWO_SIDED;
+    interior
+        .par_iter()
+        .map(|&n| {
+            let children = [n + 1, (rows[3 * n + 2][2] & !flags) as usize];
+            let mut p = LightPair::default();
+            for (lane, &c) in children.iter().enumerate() {
+                let [r0, r1, r2] = [rows[3 * c], rows[3 * c + 1], rows[3 * c + 2]];
+                let f = f32::from_bits;
+                for k in 0..3 {
+                    p.lo[k][lane] = f(r0[k]);
+                    p.hi[k][lane] = f(r1[k]);
+                    p.axis[k][lane] = axes[c][k];
+                }
+                p.phi[lane] = f(r0[3]);
+                p.cos_o[lane] = f(r2[0]);
+                p.cos_e[lane] = f(r2[1]);
+                p.sin_o[lane] = f(r2[3]);
+                p.next[lane] = if r2[2] & LIGHT_LEAF != 0 { r2[2] } else { ordinal[c] | (r2[2] & LIGHT_TWO_SIDED) };
+            }
+            p
+        })
+        .collect()
+}
