@@ -76,6 +76,7 @@ const LIGHT_SAMPLER_TREE: u32 = 1u;
 // The largest f32 below 1: rescaled numbers stay in [0, 1).
 const ONE_MINUS_EPSILON: f32 = 0.99999994;
 const LIGHT_NODE_ROWS: u32 = 3u;
+const LIGHT_TREE_WIDTH: u32 = 4u;
 const LIGHT_LEAF: u32 = 0x80000000u;
 const LIGHT_TWO_SIDED: u32 = 0x40000000u;
 

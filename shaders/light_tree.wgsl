@@ -23,7 +23,7 @@ struct LightNode {
     cos_o: f32,
     sin_o: f32,
     cos_e: f32,
-    // Child 1 (interior) or the emitter (leaf).
+    // The first child (interior) or the emitter (leaf).
     index: u32,
     leaf: bool,
     two_sided: bool,
@@ -125,84 +125,114 @@ struct TreeChoice {
     pmf: f32,
 }
 
-// The children of interior node `node` (stored at index `at`) with their importances;
-// ok = false at a dead end (neither child can contribute). Both walks step through this.
+// The children of an interior node: a group of LIGHT_TREE_WIDTH records from `first`, with
+// their shares (child_importance of each against their sum, added in slot order); ok = false
+// at a dead end (no child can contribute). Both walks step through this.
 struct Children {
-    c0: LightNode,
-    c1: LightNode,
-    i0: vec2<f32>,
-    i1: vec2<f32>,
-    total: vec2<f32>,
+    share: array<f32, 4>,
+    index: array<u32, 4>,
+    leaf: array<bool, 4>,
     ok: bool,
 }
 
-fn children(ctx: LightContext, node: LightNode, at: u32) -> Children {
-    let c0 = load_light_node(at + 1u);
-    let c1 = load_light_node(node.index);
-    let i0 = child_importance(ctx, c0);
-    let i1 = child_importance(ctx, c1);
-    let total = i0 + i1;
-    return Children(c0, c1, i0, i1, total, total.x > 0.0);
+fn children(ctx: LightContext, first: u32) -> Children {
+    var ch: Children;
+    var far = array<f32, 4>();
+    var near = array<f32, 4>();
+    var total = vec2<f32>(0.0);
+    for (var k = 0u; k < LIGHT_TREE_WIDTH; k++) {
+        let c = load_light_node(first + k);
+        let i = child_importance(ctx, c);
+        far[k] = i.x;
+        near[k] = i.y;
+        ch.index[k] = c.index;
+        ch.leaf[k] = c.leaf;
+        total += i;
+    }
+    for (var k = 0u; k < LIGHT_TREE_WIDTH; k++) {
+        ch.share[k] = child_share(vec2<f32>(far[k], near[k]), total);
+    }
+    ch.ok = total.x > 0.0;
+    return ch;
+}
+
+struct Choice {
+    slot: u32,
+    u: f32,
+}
+
+// The slot `u` chooses by the shares (at least one positive), and `u` rescaled into its
+// interval: slots of no share are passed over, and the last with a share takes the rest up
+// to 1, so rounding never leaves `u` unchosen. With two children: the binary walk's choice.
+fn choose_child(share: array<f32, 4>, u: f32) -> Choice {
+    var last = 0u;
+    for (var k = 0u; k < LIGHT_TREE_WIDTH; k++) {
+        if (share[k] > 0.0) {
+            last = k;
+        }
+    }
+    var below = 0.0;
+    for (var k = 0u; k < LIGHT_TREE_WIDTH; k++) {
+        let s = share[k];
+        if (!(s > 0.0)) {
+            continue;
+        }
+        if (k == last) {
+            return Choice(k, min((u - below) / (1.0 - below), ONE_MINUS_EPSILON));
+        }
+        if (u < below + s) {
+            return Choice(k, min((u - below) / s, ONE_MINUS_EPSILON));
+        }
+        below += s;
+    }
+    return Choice(last, u);
 }
 
 fn sample_light_tree(ctx: LightContext, u_in: f32) -> TreeChoice {
-    var node = load_light_node(0u);
-    if (node.leaf) {
-        return TreeChoice(node.index, select(0.0, 1.0, child_importance(ctx, node).x > 0.0));
+    let root = load_light_node(0u);
+    if (root.leaf) {
+        return TreeChoice(root.index, select(0.0, 1.0, child_importance(ctx, root).x > 0.0));
     }
-    var at = 0u;
+    var first = root.index;
     var u = u_in;
     var pmf = 1.0;
     loop {
-        let ch = children(ctx, node, at);
+        let ch = children(ctx, first);
         if (!ch.ok) {
             return TreeChoice(0u, 0.0);
         }
-        let p0 = child_share(ch.i0, ch.total);
-        if (u < p0) {
-            u = min(u / p0, ONE_MINUS_EPSILON);
-            pmf *= p0;
-            at += 1u;
-            node = ch.c0;
-        } else {
-            u = min((u - p0) / (1.0 - p0), ONE_MINUS_EPSILON);
-            pmf *= child_share(ch.i1, ch.total);
-            at = node.index;
-            node = ch.c1;
+        let choice = choose_child(ch.share, u);
+        u = choice.u;
+        pmf *= ch.share[choice.slot];
+        if (ch.leaf[choice.slot]) {
+            return TreeChoice(ch.index[choice.slot], pmf);
         }
-        if (node.leaf) {
-            return TreeChoice(node.index, pmf);
-        }
+        first = ch.index[choice.slot];
     }
     return TreeChoice(0u, 0.0);
 }
 
+// The walk down an emitter's trail: two bits a level, the slot taken.
 fn light_tree_pmf(ctx: LightContext, emitter: u32) -> f32 {
-    var node = load_light_node(0u);
-    if (node.leaf) {
-        return select(0.0, 1.0, child_importance(ctx, node).x > 0.0);
+    let root = load_light_node(0u);
+    if (root.leaf) {
+        return select(0.0, 1.0, child_importance(ctx, root).x > 0.0);
     }
     var trail = lights[params.trail_base + emitter / 4u][emitter % 4u];
-    var at = 0u;
+    var first = root.index;
     var pmf = 1.0;
     loop {
-        let ch = children(ctx, node, at);
+        let ch = children(ctx, first);
         if (!ch.ok) {
             return 0.0;
         }
-        if ((trail & 1u) == 0u) {
-            pmf *= child_share(ch.i0, ch.total);
-            at += 1u;
-            node = ch.c0;
-        } else {
-            pmf *= child_share(ch.i1, ch.total);
-            at = node.index;
-            node = ch.c1;
-        }
-        trail = trail >> 1u;
-        if (node.leaf) {
+        let slot = trail & 3u;
+        pmf *= ch.share[slot];
+        if (ch.leaf[slot]) {
             return pmf;
         }
+        first = ch.index[slot];
+        trail = trail >> 2u;
     }
     return 0.0;
 }

@@ -264,6 +264,7 @@ fn shared_constants_have_the_same_values() {
         ("TRI_MIRRORED", p::TRI_MIRRORED as f64),
         ("TRI_EMITTER_SHIFT", p::TRI_EMITTER_SHIFT as f64),
         ("LIGHT_NODE_ROWS", p::LIGHT_NODE_ROWS as f64),
+        ("LIGHT_TREE_WIDTH", p::LIGHT_TREE_WIDTH as f64),
         ("LIGHT_LEAF", p::LIGHT_LEAF as f64),
         ("LIGHT_TWO_SIDED", p::LIGHT_TWO_SIDED as f64),
         ("LIGHT_SAMPLER_POWER", veach::LightSampler::Power as u32 as f64),

@@ -2,7 +2,7 @@
 //! root with one random number, and the exact probability of choosing an emitter.
 
 use super::lights::light_entry;
-use crate::packed::{LIGHT_LEAF, LIGHT_NODE_ROWS, LIGHT_TWO_SIDED, LightPair, PackedScene};
+use crate::packed::{LIGHT_LEAF, LIGHT_NODE_ROWS, LIGHT_TWO_SIDED, LightGroup, PackedScene};
 use crate::params::Params;
 use glam::{BVec4A, Vec2, Vec3, Vec4};
 
@@ -139,29 +139,22 @@ pub fn child_share(i: Vec2, total: Vec2) -> f32 {
     0.5 * (i.x / total.x + i.y / total.y)
 }
 
-/// Two floats in the low lanes of a vector (the high lanes zero: no power, never chosen).
-#[inline(always)]
-fn lanes(a: [f32; 2]) -> Vec4 {
-    Vec4::new(a[0], a[1], 0.0, 0.0)
-}
-
 #[inline(always)]
 fn dot3(a: [Vec4; 3], b: [Vec4; 3]) -> Vec4 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// `node_importance` of both children of a pair at once, lane by lane the same operations in
+/// `node_importance` of a group's four children at once, lane by lane the same operations in
 /// the same order (so the same bits: SSE's min, max, sqrt and division round as the scalar
-/// ones do, and take the same operand on NaN): far estimates in `.0`, near in `.1`, lanes 0
-/// and 1.
+/// ones do, and take the same operand on NaN): far estimates in `.0`, near ones in `.1`.
 #[inline(always)]
-fn pair_importance(ctx: &LightContext, pair: &LightPair) -> (Vec4, Vec4) {
+fn group_importance(ctx: &LightContext, g: &LightGroup) -> (Vec4, Vec4) {
     let zero = Vec4::ZERO;
-    let phi = lanes(pair.phi);
+    let phi = Vec4::from(g.phi);
     let p = [Vec4::splat(ctx.point.x), Vec4::splat(ctx.point.y), Vec4::splat(ctx.point.z)];
     let n = [Vec4::splat(ctx.normal.x), Vec4::splat(ctx.normal.y), Vec4::splat(ctx.normal.z)];
-    let lo = pair.lo.map(lanes);
-    let hi = pair.hi.map(lanes);
+    let lo = g.lo.map(Vec4::from);
+    let hi = g.hi.map(Vec4::from);
     let pc = [0, 1, 2].map(|k| Vec4::splat(0.5) * (lo[k] + hi[k]));
     let half = [0, 1, 2].map(|k| Vec4::splat(0.5) * (hi[k] - lo[k]));
     let mut dead = phi.cmple(zero);
@@ -179,9 +172,9 @@ fn pair_importance(ctx: &LightContext, pair: &LightPair) -> (Vec4, Vec4) {
     let inside = dist2.cmple(r2);
     let inv_d = Vec4::ONE / dist2.sqrt();
     let wi = to_p.map(|c| c * inv_d);
-    let mut cos_w = dot3(pair.axis.map(lanes), wi);
-    let two_sided = pair.next.map(|x| x & LIGHT_TWO_SIDED != 0);
-    cos_w = Vec4::select(BVec4A::new(two_sided[0], two_sided[1], false, false), cos_w.abs(), cos_w);
+    let mut cos_w = dot3(g.axis.map(Vec4::from), wi);
+    let two_sided = g.next.map(|x| x & LIGHT_TWO_SIDED != 0);
+    cos_w = Vec4::select(BVec4A::from_array(two_sided), cos_w.abs(), cos_w);
     let safe_sqrt = |x: Vec4| x.max(zero).sqrt();
     let cos_sub = |sa: Vec4, ca: Vec4, sb: Vec4, cb: Vec4| Vec4::select(ca.cmpgt(cb), Vec4::ONE, ca * cb + sa * sb);
     let sin_sub = |sa: Vec4, ca: Vec4, sb: Vec4, cb: Vec4| Vec4::select(ca.cmpgt(cb), zero, sa * cb - ca * sb);
@@ -189,11 +182,11 @@ fn pair_importance(ctx: &LightContext, pair: &LightPair) -> (Vec4, Vec4) {
     let sin2_b = r2 * (inv_d * inv_d);
     let cos_b = safe_sqrt(Vec4::ONE - sin2_b);
     let sin_b = sin2_b.sqrt();
-    let (sin_o, cos_o) = (lanes(pair.sin_o), lanes(pair.cos_o));
+    let (sin_o, cos_o) = (Vec4::from(g.sin_o), Vec4::from(g.cos_o));
     let cos_x = cos_sub(sin_w, cos_w, sin_o, cos_o);
     let sin_x = sin_sub(sin_w, cos_w, sin_o, cos_o);
     let cos_p = cos_sub(sin_x, cos_x, sin_b, cos_b);
-    let culled = cos_p.cmple(lanes(pair.cos_e));
+    let culled = cos_p.cmple(Vec4::from(g.cos_e));
     let cos_i = dot3(wi, n).abs();
     let sin_i = safe_sqrt(Vec4::ONE - cos_i * cos_i);
     let cos_pi = cos_sub(sin_i, cos_i, sin_b, cos_b);
@@ -206,28 +199,56 @@ fn pair_importance(ctx: &LightContext, pair: &LightPair) -> (Vec4, Vec4) {
     (Vec4::select(dead, zero, far), Vec4::select(dead, zero, near))
 }
 
-/// The children of a pair with their importances (`child_importance` of each: the pair's
-/// lanes, then the plane test of one-sided leaf triangles), or None at a dead end (neither
-/// child can contribute). Both walks step through this.
+/// The shares of a group's children (`child_importance` of each: the group's lanes, then the
+/// plane test of one-sided leaf triangles; `child_share` against their sum), or None at a
+/// dead end (no child can contribute). Both walks step through this.
 #[inline(always)]
-fn children(scene: &PackedScene, params: &Params, ctx: &LightContext, pair: &LightPair) -> Option<[Vec2; 3]> {
-    let (far, near) = pair_importance(ctx, pair);
-    let mut i = [Vec2::new(far.x, near.x), Vec2::new(far.y, near.y)];
-    for (lane, imp) in i.iter_mut().enumerate() {
-        let next = pair.next[lane];
+fn group_shares(scene: &PackedScene, params: &Params, ctx: &LightContext, g: &LightGroup) -> Option<[f32; 4]> {
+    let (far, near) = group_importance(ctx, g);
+    let (mut far, mut near) = (far.to_array(), near.to_array());
+    for lane in 0..4 {
+        let next = g.next[lane];
         let emitter = next & !(LIGHT_LEAF | LIGHT_TWO_SIDED);
-        if imp.x > 0.0 && next & (LIGHT_LEAF | LIGHT_TWO_SIDED) == LIGHT_LEAF && emitter < params.light_count {
+        if far[lane] > 0.0 && next & (LIGHT_LEAF | LIGHT_TWO_SIDED) == LIGHT_LEAF && emitter < params.light_count {
             let [p0, n] = scene.light_planes[emitter as usize];
             if n.dot(ctx.point - p0) <= 0.0 {
-                *imp = Vec2::ZERO;
+                (far[lane], near[lane]) = (0.0, 0.0);
             }
         }
     }
-    let total = i[0] + i[1];
+    // In slot order, as the kernel adds them.
+    let total = Vec2::new(((far[0] + far[1]) + far[2]) + far[3], ((near[0] + near[1]) + near[2]) + near[3]);
     if total.x.is_nan() || total.x <= 0.0 {
         return None;
     }
-    Some([i[0], i[1], total])
+    Some([0, 1, 2, 3].map(|k| child_share(Vec2::new(far[k], near[k]), total)))
+}
+
+/// The slot `u` chooses among children with `shares` (of which at least one is positive),
+/// and `u` rescaled into its interval: slots of no share are passed over, and the last one
+/// with a share takes the interval's rest up to 1, so that rounding never leaves `u` unchosen.
+/// With two children this is the binary walk's choice exactly.
+pub fn choose_child(shares: [f32; 4], u: f32) -> (usize, f32) {
+    let mut last = 0;
+    for (k, &s) in shares.iter().enumerate() {
+        if s > 0.0 {
+            last = k;
+        }
+    }
+    let mut below = 0.0f32;
+    for (k, &s) in shares.iter().enumerate() {
+        if s.is_nan() || s <= 0.0 {
+            continue;
+        }
+        if k == last {
+            return (k, ((u - below) / (1.0 - below)).min(ONE_MINUS_EPSILON));
+        }
+        if u < below + s {
+            return (k, ((u - below) / s).min(ONE_MINUS_EPSILON));
+        }
+        below += s;
+    }
+    (last, u)
 }
 
 /// Chooses an emitter: at each node a child by its share, `u` rescaled into the chosen
@@ -238,30 +259,24 @@ pub fn sample_light_tree(scene: &PackedScene, params: &Params, ctx: &LightContex
     if root.leaf {
         return (root.index, if child_importance(scene, params, ctx, &root).x > 0.0 { 1.0 } else { 0.0 });
     }
-    let mut pair = &scene.light_pairs[0];
+    let mut group = &scene.light_groups[0];
     let mut u = u;
     let mut pmf = 1.0f32;
     loop {
-        let Some([i0, i1, total]) = children(scene, params, ctx, pair) else { return (0, 0.0) };
-        let p0 = child_share(i0, total);
-        let next = if u < p0 {
-            u = (u / p0).min(ONE_MINUS_EPSILON);
-            pmf *= p0;
-            pair.next[0]
-        } else {
-            u = ((u - p0) / (1.0 - p0)).min(ONE_MINUS_EPSILON);
-            pmf *= child_share(i1, total);
-            pair.next[1]
-        };
+        let Some(shares) = group_shares(scene, params, ctx, group) else { return (0, 0.0) };
+        let (slot, rescaled) = choose_child(shares, u);
+        u = rescaled;
+        pmf *= shares[slot];
+        let next = group.next[slot];
         if next & LIGHT_LEAF != 0 {
             return (next & !(LIGHT_LEAF | LIGHT_TWO_SIDED), pmf);
         }
-        pair = &scene.light_pairs[(next & !LIGHT_TWO_SIDED) as usize];
+        group = &scene.light_groups[(next & !LIGHT_TWO_SIDED) as usize];
     }
 }
 
 /// The probability that `sample_light_tree` chooses `emitter` from `ctx`: the walk down its
-/// trail, multiplying the same shares in the same order.
+/// trail (two bits a level: the slot taken), multiplying the same shares in the same order.
 pub fn light_tree_pmf(scene: &PackedScene, params: &Params, ctx: &LightContext, emitter: u32) -> f32 {
     let root = load_light_node(scene, params, 0);
     if root.leaf {
@@ -269,17 +284,17 @@ pub fn light_tree_pmf(scene: &PackedScene, params: &Params, ctx: &LightContext, 
     }
     let row = scene.light_rows[(params.trail_base + emitter / 4) as usize];
     let mut trail = row[(emitter % 4) as usize];
-    let mut pair = &scene.light_pairs[0];
+    let mut group = &scene.light_groups[0];
     let mut pmf = 1.0f32;
     loop {
-        let Some([i0, i1, total]) = children(scene, params, ctx, pair) else { return 0.0 };
-        let lane = (trail & 1) as usize;
-        pmf *= child_share(if lane == 0 { i0 } else { i1 }, total);
-        let next = pair.next[lane];
-        trail >>= 1;
+        let Some(shares) = group_shares(scene, params, ctx, group) else { return 0.0 };
+        let slot = (trail & 3) as usize;
+        pmf *= shares[slot];
+        let next = group.next[slot];
+        trail >>= 2;
         if next & LIGHT_LEAF != 0 {
             return pmf;
         }
-        pair = &scene.light_pairs[(next & !LIGHT_TWO_SIDED) as usize];
+        group = &scene.light_groups[(next & !LIGHT_TWO_SIDED) as usize];
     }
 }

@@ -36,7 +36,11 @@ pub const MAX_EMITTERS: usize = (1 << (32 - TRI_EMITTER_SHIFT)) - 1;
 
 /// Rows (vec4<u32>) per light-tree node in the `lights` buffer.
 pub const LIGHT_NODE_ROWS: u32 = 3;
-/// A light-tree node's index word: set on leaves (the rest is the emitter or child 1).
+/// Children of an interior light-tree node: a group of this many consecutive records (the
+/// binary tree's grandchildren; unused slots have no power).
+pub const LIGHT_TREE_WIDTH: u32 = 4;
+/// A light-tree node's index word: set on leaves (the rest is the emitter, or an interior
+/// node's first child).
 pub const LIGHT_LEAF: u32 = 1 << 31;
 /// A light-tree node's index word: some emitter below emits from both faces.
 pub const LIGHT_TWO_SIDED: u32 = 1 << 30;

@@ -1,7 +1,7 @@
 //! The light BVH as the kernel reads it: three rows per node, then the emitters' trails,
 //! four per row, after the alias table in the `lights` buffer (see `PackedScene::light_rows`).
 //!
-//! Node rows: (lo.xyz, phi), (hi.xyz, octahedral axis), (cos θ_o, cos θ_e, child 1 or
+//! Node rows: (lo.xyz, phi), (hi.xyz, octahedral axis), (cos θ_o, cos θ_e, first child or
 //! emitter | LIGHT_LEAF | LIGHT_TWO_SIDED, sin θ_o). Floats are stored as f32 bits,
 //! unquantized, so the boxes are exact; only the axis is quantized, and θ_o is widened by
 //! its error so the cone still holds every emitter's normal. sin θ_o is stored so both
@@ -51,21 +51,32 @@ fn finite_power(phi: f32) -> f32 {
     if phi.is_finite() { phi.max(0.0) } else { 0.0 }
 }
 
+/// The binary tree's grandchildren (a child that is a leaf stands for itself) become a node's
+/// children: the walk takes half the steps and weighs up to four subtrees against each other.
+const LIGHT_TREE_WIDTH: usize = super::layout::LIGHT_TREE_WIDTH as usize;
+
 /// The packed tree.
 pub struct PackedLightTree {
     /// Node rows then trail rows.
     pub rows: Vec<[u32; 4]>,
+    /// Node records (three rows each): the root, then groups of `LIGHT_TREE_WIDTH` siblings.
     pub nodes: usize,
     pub trail_offset: u32,
+    /// Deepest leaf of the packed tree (the root is depth 0).
     pub depth: u32,
     pub build_seconds: f64,
 }
 
+/// Packs the binary light BVH as a 4-wide tree. Record 0 is the root; an interior record's
+/// index names the first of its group of four children (records `LIGHT_TREE_WIDTH` apart,
+/// children first, unused slots zero: no power, never chosen). An emitter's trail holds the
+/// slot taken at each level, two bits a level (depth ≤ 16: the binary tree's ≤ 32 halved).
 pub fn pack_light_tree(emitters: &[LightBounds]) -> PackedLightTree {
-    let LightBvh { nodes, trails, depth, build_seconds } = build_light_bvh(emitters);
-    let mut rows: Vec<[u32; 4]> = Vec::with_capacity(3 * nodes.len() + trails.len().div_ceil(4));
-    rows.resize(3 * nodes.len(), [0; 4]);
-    rows.par_chunks_mut(3).zip(nodes.par_iter()).for_each(|(out, n)| {
+    let t0 = std::time::Instant::now();
+    let LightBvh { nodes, trails: _, depth: _, build_seconds: _ } = build_light_bvh(emitters);
+    // Every binary node's three rows (its index field filled in below).
+    let mut encoded: Vec<[[u32; 4]; 3]> = vec![[[0; 4]; 3]; nodes.len()];
+    encoded.par_iter_mut().zip(nodes.par_iter()).for_each(|(out, n)| {
         let b = &n.bounds;
         let axis_bits = oct_encode(b.axis);
         // Widen the cone by the quantized axis' error, plus slack for the GPU's decode.
@@ -73,62 +84,96 @@ pub fn pack_light_tree(emitters: &[LightBounds]) -> PackedLightTree {
         let cos_o = if b.cos_o <= -1.0 { -1.0 } else { widen(b.cos_o as f64, err + 2e-5) };
         let sin_o = (1.0 - cos_o * cos_o).max(0.0).sqrt();
         let f = |x: f32| x.to_bits();
-        let index = n.index | if n.leaf { LIGHT_LEAF } else { 0 } | if b.two_sided { LIGHT_TWO_SIDED } else { 0 };
+        let flags = if n.leaf { LIGHT_LEAF | n.index } else { 0 } | if b.two_sided { LIGHT_TWO_SIDED } else { 0 };
         out[0] = [f(b.lo.x), f(b.lo.y), f(b.lo.z), f(b.phi)];
         out[1] = [f(b.hi.x), f(b.hi.y), f(b.hi.z), axis_bits];
-        out[2] = [f(cos_o), f(b.cos_e), index, f(sin_o)];
+        out[2] = [f(cos_o), f(b.cos_e), flags, f(sin_o)];
     });
+    let mut records: Vec<[[u32; 4]; 3]> = Vec::with_capacity(nodes.len());
+    let mut trails = vec![0u32; emitters.len()];
+    let mut depth = 0;
+    if let Some(root) = encoded.first() {
+        records.push(*root);
+        if nodes[0].leaf {
+            trails[nodes[0].index as usize] = 0;
+        }
+    }
+    // (binary node, its record, trail so far, level of its children)
+    let mut stack: Vec<(usize, usize, u32, u32)> = Vec::new();
+    if nodes.first().is_some_and(|n| !n.leaf) {
+        stack.push((0, 0, 0, 0));
+    }
+    while let Some((b, r, trail, level)) = stack.pop() {
+        let mut kids = [0usize; LIGHT_TREE_WIDTH];
+        let mut count = 0;
+        for c in [b + 1, nodes[b].index as usize] {
+            if nodes[c].leaf {
+                kids[count] = c;
+                count += 1;
+            } else {
+                kids[count] = c + 1;
+                kids[count + 1] = nodes[c].index as usize;
+                count += 2;
+            }
+        }
+        let group = records.len();
+        records[r][2][2] |= group as u32;
+        records.extend(std::iter::repeat_n([[0; 4]; 3], LIGHT_TREE_WIDTH));
+        depth = depth.max(level + 1);
+        for (slot, &k) in kids[..count].iter().enumerate() {
+            let t = trail | (slot as u32) << (2 * level);
+            records[group + slot] = encoded[k];
+            if nodes[k].leaf {
+                trails[nodes[k].index as usize] = t;
+            } else {
+                stack.push((k, group + slot, t, level + 1));
+            }
+        }
+    }
+    let mut rows: Vec<[u32; 4]> = Vec::with_capacity(3 * records.len() + trails.len().div_ceil(4));
+    rows.extend(records.iter().flatten());
     let trail_offset = rows.len() as u32;
     for chunk in trails.chunks(4) {
         let mut row = [0; 4];
         row[..chunk.len()].copy_from_slice(chunk);
         rows.push(row);
     }
-    PackedLightTree { rows, nodes: nodes.len(), trail_offset, depth, build_seconds }
+    let build_seconds = t0.elapsed().as_secs_f64();
+    PackedLightTree { rows, nodes: records.len(), trail_offset, depth, build_seconds }
 }
 
-/// The two children of an interior node of the light tree, decoded for the CPU engine, which
-/// evaluates both children's importance at once in SIMD lanes (lane 0: the first child, at the
-/// parent's index + 1; lane 1: the second). The values are the node rows' own bits (the axis
-/// decoded as the kernel decodes it), so both twins still compute the same numbers.
+/// The children of an interior node of the light tree (a group of `LIGHT_TREE_WIDTH`
+/// records), decoded for the CPU engine, which evaluates their importances at once in SIMD
+/// lanes (lane k: slot k). The values are the node rows' own bits (the axis decoded as the
+/// kernel decodes it), so both twins compute the same numbers.
 #[derive(Clone, Copy, Debug, Default)]
-#[repr(C, align(8))]
-pub struct LightPair {
-    pub lo: [[f32; 2]; 3],
-    pub hi: [[f32; 2]; 3],
-    pub axis: [[f32; 2]; 3],
-    pub phi: [f32; 2],
-    pub cos_o: [f32; 2],
-    pub sin_o: [f32; 2],
-    pub cos_e: [f32; 2],
-    /// Per child: a leaf's emitter | LIGHT_LEAF | LIGHT_TWO_SIDED, or an interior child's
-    /// own pair index | LIGHT_TWO_SIDED.
-    pub next: [u32; 2],
+#[repr(C, align(16))]
+pub struct LightGroup {
+    pub lo: [[f32; 4]; 3],
+    pub hi: [[f32; 4]; 3],
+    pub axis: [[f32; 4]; 3],
+    pub phi: [f32; 4],
+    pub cos_o: [f32; 4],
+    pub sin_o: [f32; 4],
+    pub cos_e: [f32; 4],
+    /// Per slot: a leaf's emitter | LIGHT_LEAF | LIGHT_TWO_SIDED, or an interior child's
+    /// own group index | LIGHT_TWO_SIDED.
+    pub next: [u32; 4],
 }
 
-/// The pairs of the tree whose node rows are `rows` (`nodes` of them, axes decoded in
-/// `axes`), indexed so that the root's children are pair 0; empty when the root is a leaf.
-pub fn light_pairs(rows: &[[u32; 4]], nodes: usize, axes: &[Vec3]) -> Vec<LightPair> {
-    let is_leaf = |n: usize| rows[3 * n + 2][2] & LIGHT_LEAF != 0;
-    if nodes == 0 || is_leaf(0) {
+/// The groups of the tree whose node rows are `rows` (`nodes` records, axes decoded in
+/// `axes`), group g holding records 1 + 4g ..; empty when the root is a leaf.
+pub fn light_groups(rows: &[[u32; 4]], nodes: usize, axes: &[Vec3]) -> Vec<LightGroup> {
+    if nodes <= 1 {
         return Vec::new();
     }
-    // Interior nodes in index order: pair k holds the children of the k-th interior node.
-    let mut ordinal = vec![u32::MAX; nodes];
-    let mut interior = Vec::new();
-    for (n, o) in ordinal.iter_mut().enumerate() {
-        if !is_leaf(n) {
-            *o = interior.len() as u32;
-            interior.push(n);
-        }
-    }
-    let flags = LIGHT_LEAF | LIGHT_TWO_SIDED;
-    interior
-        .par_iter()
-        .map(|&n| {
-            let children = [n + 1, (rows[3 * n + 2][2] & !flags) as usize];
-            let mut p = LightPair::default();
-            for (lane, &c) in children.iter().enumerate() {
+    let group_of = |record: u32| (record - 1) / LIGHT_TREE_WIDTH as u32;
+    (0..(nodes - 1) / LIGHT_TREE_WIDTH)
+        .into_par_iter()
+        .map(|g| {
+            let mut p = LightGroup::default();
+            for lane in 0..LIGHT_TREE_WIDTH {
+                let c = 1 + LIGHT_TREE_WIDTH * g + lane;
                 let [r0, r1, r2] = [rows[3 * c], rows[3 * c + 1], rows[3 * c + 2]];
                 let f = f32::from_bits;
                 for k in 0..3 {
@@ -140,7 +185,12 @@ pub fn light_pairs(rows: &[[u32; 4]], nodes: usize, axes: &[Vec3]) -> Vec<LightP
                 p.cos_o[lane] = f(r2[0]);
                 p.cos_e[lane] = f(r2[1]);
                 p.sin_o[lane] = f(r2[3]);
-                p.next[lane] = if r2[2] & LIGHT_LEAF != 0 { r2[2] } else { ordinal[c] | (r2[2] & LIGHT_TWO_SIDED) };
+                let index = r2[2] & !(LIGHT_LEAF | LIGHT_TWO_SIDED);
+                p.next[lane] = if r2[2] & LIGHT_LEAF != 0 || f(r0[3]) <= 0.0 {
+                    r2[2] | LIGHT_LEAF
+                } else {
+                    group_of(index) | (r2[2] & LIGHT_TWO_SIDED)
+                };
             }
             p
         })

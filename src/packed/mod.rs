@@ -17,7 +17,7 @@ mod textures;
 pub use crate::accel::{BvhNode, CwNode, INSTANCE_MIRRORED, Instance};
 pub use features::Features;
 pub use layout::*;
-pub use light_tree::LightPair;
+pub use light_tree::LightGroup;
 pub use materials::{dielectric_f0, luminance, pack_material};
 pub use octahedral::{oct_decode, oct_encode};
 pub use textures::{
@@ -61,15 +61,16 @@ pub struct PackedScene {
     pub materials: Vec<Material>,
     pub lights: Vec<LightEntry>,
     /// The `lights` buffer: the alias table (one row per entry, `LightEntry` as u32 bits),
-    /// then from `tree_base` the light tree's nodes (`LIGHT_NODE_ROWS` rows each) and from
+    /// then from `tree_base` the light tree's node records (`LIGHT_NODE_ROWS` rows each: the
+    /// root, then groups of `LIGHT_TREE_WIDTH` siblings) and from
     /// `trail_base` its emitters' trails, four per row. At least one row.
     pub light_rows: Vec<[u32; 4]>,
     /// The light tree's node axes decoded (`oct_decode` of each node's axis word), for the
     /// CPU engine: decoding is a normalization per node visit.
     pub light_axes: Vec<Vec3>,
-    /// The tree's interior nodes' children decoded in pairs (`light_tree::light_pairs`), for
-    /// the CPU engine's two-lane walk; empty when the root is a leaf or there is no tree.
-    pub light_pairs: Vec<LightPair>,
+    /// The tree's groups of siblings decoded (`light_tree::light_groups`), for the CPU
+    /// engine's four-lane walk; empty when the root is a leaf or there is no tree.
+    pub light_groups: Vec<LightGroup>,
     /// Per emissive triangle of the alias table: its first vertex and cross(e1, e2), the plane
     /// the walk tests one-sided leaves against (the same products the triangle gives).
     pub light_planes: Vec<[Vec3; 2]>,
@@ -188,12 +189,12 @@ impl PackedScene {
         let mut light_rows: Vec<[u32; 4]> = bytemuck::cast_slice(&lights).to_vec();
         let tree_base = light_rows.len() as u32;
         let mut light_axes = Vec::new();
-        let mut light_pairs = Vec::new();
+        let mut light_groups = Vec::new();
         let (tree_emitters, trail_base, light_tree_nodes, light_tree_depth, light_tree_seconds) = match tree {
             Some(t) => {
                 light_rows.extend_from_slice(&t.rows);
                 light_axes = t.rows[..3 * t.nodes].chunks(3).map(|r| octahedral::oct_decode(r[1][3])).collect();
-                light_pairs = light_tree::light_pairs(&t.rows, t.nodes, &light_axes);
+                light_groups = light_tree::light_groups(&t.rows, t.nodes, &light_axes);
                 (emitters.len() as u32, tree_base + t.trail_offset, t.nodes, t.depth, t.build_seconds)
             }
             None => (0, tree_base, 0, 0, 0.0),
@@ -255,7 +256,7 @@ impl PackedScene {
             lights,
             light_rows,
             light_axes,
-            light_pairs,
+            light_groups,
             light_planes: Vec::new(),
             tree_emitters,
             tree_base,
