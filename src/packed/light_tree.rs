@@ -94,9 +94,6 @@ pub fn pack_light_tree(emitters: &[LightBounds]) -> PackedLightTree {
     let mut depth = 0;
     if let Some(root) = encoded.first() {
         records.push(*root);
-        if nodes[0].leaf {
-            trails[nodes[0].index as usize] = 0;
-        }
     }
     // (binary node, its record, trail so far, level of its children)
     let mut stack: Vec<(usize, usize, u32, u32)> = Vec::new();
