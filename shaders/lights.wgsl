@@ -61,7 +61,7 @@ fn barycentrics(v: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>) -> vec2<f32> {
 // The solid angle of `tri` from `p` when the tree's light sampling samples it by solid
 // angle (p in front, the angle within [SOLID_ANGLE_MIN, SOLID_ANGLE_MAX]), else 0 (by area).
 fn triangle_solid_angle(p: vec3<f32>, tri: Triangle) -> f32 {
-    if (dot(cross(tri.e1, tri.e2), p - tri.p0) <= 0.0) {
+    if (dot(cross(tri.e1, tri.e2), p - tri.p0) <= 0.0 || surely_below_solid_angle_min(p, tri.p0, tri.e1, tri.e2)) {
         return 0.0;
     }
     let omega = spherical_triangle_area(p, tri.p0, tri.p0 + tri.e1, tri.p0 + tri.e2);

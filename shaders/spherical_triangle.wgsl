@@ -4,12 +4,26 @@
 // the same branch through `spherical_triangle_area`. Twin: src/cpu/spherical_triangle.rs.
 #include "common.wgsl"
 
-const SOLID_ANGLE_MIN: f32 = 1e-3;
+const SOLID_ANGLE_MIN: f32 = 2e-2;
 const SOLID_ANGLE_MAX: f32 = 6.22;
 
 fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
     let len2 = dot(v, v);
     return select(vec3<f32>(0.0), v * (1.0 / sqrt(len2)), len2 > 0.0);
+}
+
+// Whether the triangle's solid angle from `p` is surely below SOLID_ANGLE_MIN, without the
+// exact formula: the triangle lies in the ball of radius r about its centroid c, whose cap
+// subtends at most 2π r²/d² (d = |p − c|); widened by 1 % so rounding never skips a triangle
+// the exact formula keeps.
+fn surely_below_solid_angle_min(p: vec3<f32>, p0: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>) -> bool {
+    let c = p0 + (e1 + e2) * (1.0 / 3.0);
+    let a = p0 - c;
+    let b = p0 + e1 - c;
+    let d = p0 + e2 - c;
+    let r2 = max(max(dot(a, a), dot(b, b)), dot(d, d));
+    let pc = p - c;
+    return 6.35 * r2 < SOLID_ANGLE_MIN * dot(pc, pc);
 }
 
 // The solid angle of the triangle seen from `p` (van Oosterom & Strackee).

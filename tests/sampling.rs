@@ -219,7 +219,7 @@ fn spherical_triangle_inversion_recovers_the_sample() {
         spherical_triangle_area,
     };
     let mut rng = Lcg(23);
-    for s in [0.4f32, 1.0, 3.0, 30.0] {
+    for s in [0.8f32, 1.0, 3.0, 30.0] {
         let v = [Vec3::new(0.0, 0.0, 3.0), Vec3::new(s, 0.0, 3.0), Vec3::new(0.0, 0.8 * s, 3.0 + 0.5 * s)];
         let omega = spherical_triangle_area(Vec3::ZERO, v[0], v[1], v[2]);
         assert!((SOLID_ANGLE_MIN..=SOLID_ANGLE_MAX).contains(&omega), "size {s}: Ω = {omega}");
@@ -236,6 +236,79 @@ fn spherical_triangle_inversion_recovers_the_sample() {
             assert!(worst < 0.02, "size {s} (Ω = {omega}), normal {n}: the density read back is off by {worst}");
         }
     }
+}
+
+/// Random triangles seen from log-uniform distances of 0.1 to 100 triangle sizes: (p, p0, e1, e2).
+fn shortcut_cases(n: usize) -> Vec<[Vec3; 4]> {
+    let mut rng = Lcg(29);
+    let mut v3 = |scale: f32| Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5) * scale;
+    (0..n)
+        .map(|i| {
+            let (p0, e1, e2) = (v3(2.0), v3(2.0), v3(2.0));
+            let dist = 10f32.powf(-1.0 + 3.0 * (i as f32 / n as f32));
+            let p = p0 + v3(1.0).normalize_or_zero() * dist * e1.length().max(e2.length());
+            [p, p0, e1, e2]
+        })
+        .collect()
+}
+
+/// The cheap test that skips the exact solid angle never skips a triangle the exact formula
+/// would sample by solid angle (so the shortcut changes no choice), and does skip distant
+/// ones (so it is not vacuous): random triangles from random points at distances spanning
+/// the threshold.
+#[test]
+fn the_solid_angle_shortcut_is_conservative() {
+    use veach::cpu::spherical_triangle::{SOLID_ANGLE_MIN, spherical_triangle_area, surely_below_solid_angle_min};
+    let (mut skipped, mut kept_small) = (0, 0);
+    for [p, p0, e1, e2] in shortcut_cases(200_000) {
+        let omega = spherical_triangle_area(p, p0, p0 + e1, p0 + e2);
+        if surely_below_solid_angle_min(p, p0, e1, e2) {
+            assert!(omega < SOLID_ANGLE_MIN, "skipped a triangle of Ω = {omega} ≥ {SOLID_ANGLE_MIN}");
+            skipped += 1;
+        } else if omega < SOLID_ANGLE_MIN {
+            kept_small += 1;
+        }
+    }
+    assert!(skipped > 50_000, "the shortcut skipped only {skipped} of 200000");
+    println!("skipped {skipped}, left to the exact formula below the threshold {kept_small}");
+}
+
+/// The WGSL twin of the shortcut decides as the Rust one does, and is as conservative: run on
+/// the GPU over the same triangles, it skips the same ones (apart from ties within float
+/// rounding of its two sides) and never one whose exact solid angle reaches the threshold.
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn the_wgsl_solid_angle_shortcut_decides_as_the_rust_one() {
+    use veach::cpu::spherical_triangle::{SOLID_ANGLE_MIN, spherical_triangle_area, surely_below_solid_angle_min};
+    let Some(ctx) = common::gpu("the_wgsl_solid_angle_shortcut_decides_as_the_rust_one") else { return };
+    let cases = shortcut_cases(200_000);
+    let input: Vec<[f32; 4]> = cases.iter().flatten().map(|v| v.extend(0.0).to_array()).collect();
+    let body = "let p = probe_in[i * 4u].xyz;
+    let p0 = probe_in[i * 4u + 1u].xyz;
+    let e1 = probe_in[i * 4u + 2u].xyz;
+    let e2 = probe_in[i * 4u + 3u].xyz;
+    let skip = surely_below_solid_angle_min(p, p0, e1, e2);
+    let omega = spherical_triangle_area(p, p0, p0 + e1, p0 + e2);
+    probe_out[i] = vec4<f32>(select(0.0, 1.0, skip), omega, 0.0, 0.0);";
+    let out = common::probe::run(&ctx, "spherical_triangle.wgsl", body, &input, 4, 1);
+    let (mut skipped, mut ties) = (0, 0);
+    for (&[p, p0, e1, e2], o) in cases.iter().zip(&out) {
+        let gpu_skip = o[0] == 1.0;
+        let exact = spherical_triangle_area(p, p0, p0 + e1, p0 + e2);
+        assert!(!gpu_skip || exact < SOLID_ANGLE_MIN, "the GPU skipped a triangle of Ω = {exact} (GPU Ω {})", o[1]);
+        assert!((o[1] - exact).abs() <= 1e-4 * exact.max(1e-3), "solid angle {} on the GPU, {exact} on the CPU", o[1]);
+        if gpu_skip != surely_below_solid_angle_min(p, p0, e1, e2) {
+            // Only a tie may decide differently: the two sides equal to float rounding.
+            let c = p0 + (e1 + e2) / 3.0;
+            let r2 = (p0 - c).length_squared().max((p0 + e1 - c).length_squared()).max((p0 + e2 - c).length_squared());
+            let (lhs, rhs) = (6.35 * r2, SOLID_ANGLE_MIN * (p - c).length_squared());
+            assert!((lhs - rhs).abs() <= 1e-5 * rhs, "GPU and CPU decide differently: {lhs} vs {rhs}");
+            ties += 1;
+        }
+        skipped += gpu_skip as u32;
+    }
+    assert!(skipped > 50_000, "the GPU skipped only {skipped} of 200000");
+    println!("the GPU skipped {skipped}; {ties} ties decided differently");
 }
 
 /// The harness rejects a sampler that does not draw its pdf (a 5 % distortion).

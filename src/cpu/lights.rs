@@ -7,7 +7,7 @@ use super::material::{material_at, triangle_uv};
 use super::sampling::{bilinear_pdf, sample_bilinear, sample_uniform_triangle};
 use super::spherical_triangle::{
     SOLID_ANGLE_MAX, SOLID_ANGLE_MIN, invert_spherical_triangle_sample, sample_spherical_triangle,
-    spherical_triangle_area,
+    spherical_triangle_area, surely_below_solid_angle_min,
 };
 use crate::packed::{
     LightEntry, NO_TEXTURE, PUNCTUAL_POINT, PUNCTUAL_SPOT, PackedScene, Punctual, TRI_EMITTER_SHIFT, Triangle,
@@ -155,7 +155,7 @@ pub fn barycentrics(v: Vec3, e1: Vec3, e2: Vec3) -> Vec2 {
 /// (sampled by area).
 pub fn triangle_solid_angle(p: Vec3, tri: &Triangle) -> f32 {
     let (p0, e1, e2) = (Vec3::from(tri.p0), Vec3::from(tri.e1), Vec3::from(tri.e2));
-    if e1.cross(e2).dot(p - p0) <= 0.0 {
+    if e1.cross(e2).dot(p - p0) <= 0.0 || surely_below_solid_angle_min(p, p0, e1, e2) {
         return 0.0;
     }
     let omega = spherical_triangle_area(p, p0, p0 + e1, p0 + e2);

@@ -9,8 +9,22 @@
 
 use glam::{Vec2, Vec3};
 
-pub const SOLID_ANGLE_MIN: f32 = 1e-3;
+/// Below 0.02 sr (a right triangle of area 0.5 seen from 5 units away) the inverse-square and
+/// cosine factors vary little over the triangle, so area sampling's noise is close to solid
+/// angle sampling's at a fraction of the cost (measured: BENCHMARKS.md, session 15).
+pub const SOLID_ANGLE_MIN: f32 = 2e-2;
 pub const SOLID_ANGLE_MAX: f32 = 6.22;
+
+/// Whether the triangle's solid angle from `p` is surely below `SOLID_ANGLE_MIN`, without
+/// the exact formula's three normalisations and arc tangent: the triangle lies in the ball of
+/// radius r about its centroid c, whose cap subtends 2π(1 − √(1 − r²/d²)) ≤ 2π r²/d² (d =
+/// |p − c|; when p is inside the ball the bound exceeds 2π and never skips). Widened by 1 %
+/// so rounding never skips a triangle the exact formula would keep: the choice is the same.
+pub fn surely_below_solid_angle_min(p: Vec3, p0: Vec3, e1: Vec3, e2: Vec3) -> bool {
+    let c = p0 + (e1 + e2) * (1.0 / 3.0);
+    let r2 = (p0 - c).length_squared().max((p0 + e1 - c).length_squared()).max((p0 + e2 - c).length_squared());
+    6.35 * r2 < SOLID_ANGLE_MIN * (p - c).length_squared()
+}
 
 /// The solid angle of the triangle (v0, v1, v2) seen from `p` (van Oosterom & Strackee).
 pub fn spherical_triangle_area(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> f32 {

@@ -4,6 +4,7 @@
 pub mod build;
 pub mod chi2;
 pub mod cli;
+pub mod probe;
 pub mod rng;
 
 use glam::Vec3;
