@@ -98,13 +98,24 @@ fn transmission_albedo(m: Material, cos_o: f32, eta: f32) -> vec3<f32> {
     return (1.0 - m.metallic) * m.transmission * m.base_color * (vec3<f32>(1.0) - f);
 }
 
+// Is the transmission lobe a GGX lobe (else a Dirac one)? A refracting microfacet tilted by θm
+// turns the ray by about |1 − 1/η|·θm, so the lobe is α·|1 − 1/η| wide: at η = 1 light passes
+// straight through whatever the roughness, and near it the half vector is ill-conditioned.
+// Thin walls transmit a reflection, whose width is α's.
+fn transmission_is_rough(m: Material, alpha: f32, eta: f32) -> bool {
+    if ((m.flags & MAT_THIN_WALLED) != 0u) {
+        return alpha >= DELTA_ALPHA;
+    }
+    return alpha * abs(1.0 - 1.0 / eta) >= DELTA_ALPHA;
+}
+
 // Probabilities of sampling the specular, diffuse, transmission and diffuse-transmission
 // lobes, from their albedos. A rough interface transmits through some microfacets even beyond
 // the critical angle of the macro surface, so its transmission lobe keeps at least a tenth of
 // its weight.
 fn lobe_weights(m: Material, cos_o: f32, eta: f32) -> vec4<f32> {
     var wt = luminance(transmission_albedo(m, cos_o, eta));
-    if (TRANSMISSION && m.roughness * m.roughness >= DELTA_ALPHA) {
+    if (TRANSMISSION && transmission_is_rough(m, m.roughness * m.roughness, eta)) {
         wt = max(wt, 0.1 * (1.0 - m.metallic) * m.transmission * luminance(m.base_color));
     }
     return vec4<f32>(
@@ -255,7 +266,7 @@ fn base_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> vec3<f32> {
     }
     if (wi.z < 0.0) {
         var f = diffuse_transmission_albedo(m, wo.z, eta) * INV_PI;
-        if (TRANSMISSION && alpha >= DELTA_ALPHA && m.transmission > 0.0) {
+        if (TRANSMISSION && m.transmission > 0.0 && transmission_is_rough(m, alpha, eta)) {
             f += specular_transmission_eval(m, wo, wi, eta, alpha);
         }
         return f;
@@ -277,7 +288,7 @@ fn base_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, eta: f32) -> f32 {
     let alpha = m.roughness * m.roughness;
     if (wi.z < 0.0) {
         var pdf = p.w * cosine_hemisphere_pdf(-wi.z);
-        if (TRANSMISSION && alpha >= DELTA_ALPHA && p.z > 0.0) {
+        if (TRANSMISSION && p.z > 0.0 && transmission_is_rough(m, alpha, eta)) {
             pdf += specular_transmission_pdf(m, wo, wi, eta, alpha, p.z);
         }
         return pdf;
@@ -328,15 +339,16 @@ fn base_sample(m: Material, wo: vec3<f32>, u: vec3<f32>, eta: f32) -> BsdfSample
             }
             wi = thin_reflection(r);
         } else {
+        let rough = transmission_is_rough(m, alpha, eta);
         var h = vec3<f32>(0.0, 0.0, 1.0);
-        if (alpha >= DELTA_ALPHA) {
+        if (rough) {
             h = ggx_sample_vndf(wo, alpha, u.yz);
         }
         let r = refract_dir(wo, h, eta);
         if (r.w == 0.0) {
             return none;
         }
-        if (alpha < DELTA_ALPHA) {
+        if (!rough) {
             let t = transmission_albedo(m, wo.z, eta) / (eta * eta);
             return BsdfSample(r.xyz, t / p.z, p.z, true);
         }
@@ -472,7 +484,7 @@ fn bsdf_is_delta(m: Material, wo: vec3<f32>, eta: f32) -> bool {
     let alpha = m.roughness * m.roughness;
     let p = lobe_probabilities(m, wo.z, eta);
     let base = p.y <= 0.0 && p.w <= 0.0 && (p.x <= 0.0 || !specular_is_rough(m, alpha))
-        && (p.z <= 0.0 || alpha < DELTA_ALPHA);
+        && (p.z <= 0.0 || !transmission_is_rough(m, alpha, eta));
     if (!has_layers(m)) {
         return base;
     }

@@ -427,13 +427,14 @@ fn furnace_of(name: &str, material: serde_json::Value, extensions: &[&str]) -> P
     path
 }
 
-/// The furnace sphere turned into glass of a roughness (in a directory of its own per `engine`).
-fn glass_furnace(roughness: f32, engine: &str) -> PathBuf {
+/// The furnace sphere turned into glass of a roughness and ior (in a directory of its own per
+/// `engine`).
+fn glass_furnace(roughness: f32, ior: f32, engine: &str) -> PathBuf {
     furnace_of(
-        &format!("glass-{roughness}-{engine}"),
+        &format!("glass-{roughness}-{ior}-{engine}"),
         json!({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0,
         "roughnessFactor": roughness}, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
-        "KHR_materials_ior": {"ior": 1.5}, "KHR_materials_volume": {"thicknessFactor": 1.0}}}),
+        "KHR_materials_ior": {"ior": ior}, "KHR_materials_volume": {"thicknessFactor": 1.0}}}),
         &["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"],
     )
 }
@@ -833,7 +834,7 @@ fn glass_furnace_on(ctx: Option<GpuContext>) {
     // splits, refraction's 1/η² and η² cancel on the way in and out). Rough glass may lose
     // the energy of single-scattering microfacets, never gain. Unlimited depth (roulette).
     for (roughness, min_mean) in [(0.0, 0.995), (0.3, 0.93)] {
-        let path = glass_furnace(roughness, engine(&ctx));
+        let path = glass_furnace(roughness, 1.5, engine(&ctx));
         let s = Settings { width: 48, height: 48, max_depth: 0, env_color: Some([1.0; 3]), ..Settings::default() };
         let (backend, film) = render_on(&path, &s, 32, ctx.clone());
         assert_eq!(film.nonfinite_samples(), 0);
@@ -845,6 +846,47 @@ fn glass_furnace_on(ctx: Option<GpuContext>) {
             assert_films_agree(&format!("glass r={roughness}"), &film, &render_on(&path, &s, 32, None).1);
         }
     }
+}
+
+/// Rough glass of ior 1 (and within 1e-4 of it, from both sides) bends no light: in a white
+/// furnace the sphere is invisible, every pixel 1 whatever its roughness. The generalised half
+/// vector of refraction, ωo + η ωi, vanishes at η = 1: the sphere rendered black before.
+fn index_matched_glass_on(ctx: Option<GpuContext>) {
+    let s = Settings { width: 32, height: 32, max_depth: 0, env_color: Some([1.0; 3]), ..Settings::default() };
+    let mut films = Vec::new();
+    for (roughness, ior) in [(0.5, 1.0), (1.0, 1.0), (0.5, 1.0001), (0.5, 0.9999)] {
+        let path = glass_furnace(roughness, ior, engine(&ctx));
+        let (backend, film) = render_on(&path, &s, 8, ctx.clone());
+        assert_eq!(film.nonfinite_samples(), 0);
+        let worst = (0..(s.width * s.height) as usize)
+            .map(|i| (film.mean(i) - glam::Vec3::ONE).abs().max_element())
+            .fold(0.0f32, f32::max);
+        eprintln!("glass r={roughness} ior={ior} {backend}: worst pixel off by {worst:.2e}");
+        assert!(worst < 1e-3, "glass r={roughness} ior={ior} {backend}: a pixel {worst} away from 1: the sphere shows");
+        films.push((format!("r={roughness} ior={ior}"), path, film));
+    }
+    // GPU = CPU pixel by pixel (both are 1 up to rounding, so no variance to scale by).
+    if ctx.is_some() {
+        for (what, path, film) in &films {
+            let cpu = render_on(path, &s, 8, None).1;
+            for i in 0..(s.width * s.height) as usize {
+                let d = (film.mean(i) - cpu.mean(i)).abs().max_element();
+                assert!(d < 1e-3, "{what}: pixel {i} GPU {} vs CPU {}", film.mean(i), cpu.mean(i));
+            }
+        }
+    }
+}
+
+#[test]
+fn rough_glass_of_ior_one_is_invisible_in_a_furnace() {
+    index_matched_glass_on(None);
+}
+
+#[test]
+#[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
+fn rough_glass_of_ior_one_is_invisible_in_a_furnace_on_the_gpu() {
+    let Some(ctx) = gpu("rough_glass_of_ior_one_is_invisible_in_a_furnace_on_the_gpu") else { return };
+    index_matched_glass_on(Some(ctx));
 }
 
 #[test]

@@ -109,7 +109,7 @@ pub fn transmission_albedo(m: &Material, cos_o: f32, eta: f32) -> Vec3 {
 #[inline]
 pub fn lobe_weights(m: &Material, cos_o: f32, eta: f32) -> Vec4 {
     let mut wt = luminance(transmission_albedo(m, cos_o, eta));
-    if m.roughness * m.roughness >= DELTA_ALPHA {
+    if transmission_is_rough(m, m.roughness * m.roughness, eta) {
         wt = wt.max(0.1 * (1.0 - m.metallic) * m.transmission * luminance(m.base_color.into()));
     }
     Vec4::new(
@@ -128,6 +128,19 @@ pub fn lobe_probabilities(m: &Material, cos_o: f32, eta: f32) -> Vec4 {
         return Vec4::ZERO;
     }
     w / total
+}
+
+/// Is the transmission lobe a GGX lobe (else a Dirac one)? A refracting microfacet tilted by θm
+/// turns the ray by about |1 − 1/η|·θm, so the lobe is α·|1 − 1/η| wide: at η = 1 light passes
+/// straight through whatever the roughness (and ωo + η ωi, the half vector, vanishes), and near
+/// it the lobe is narrower than a mirror's and the half vector ill-conditioned. Thin walls
+/// transmit a reflection, whose width is α's.
+#[inline]
+pub fn transmission_is_rough(m: &Material, alpha: f32, eta: f32) -> bool {
+    if m.flags & MAT_THIN_WALLED != 0 {
+        return alpha >= DELTA_ALPHA;
+    }
+    alpha * (1.0 - 1.0 / eta).abs() >= DELTA_ALPHA
 }
 
 pub fn refraction_half_vector(wo: Vec3, wi: Vec3, eta: f32) -> Vec4 {
@@ -248,7 +261,7 @@ pub fn base_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
     }
     if wi.z < 0.0 {
         let mut f = diffuse_transmission_albedo(m, wo.z, eta) * FRAC_1_PI;
-        if alpha >= DELTA_ALPHA && m.transmission > 0.0 {
+        if m.transmission > 0.0 && transmission_is_rough(m, alpha, eta) {
             f += specular_transmission_eval(m, wo, wi, eta, alpha);
         }
         return f;
@@ -287,7 +300,7 @@ pub fn base_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
     let alpha = m.roughness * m.roughness;
     if wi.z < 0.0 {
         let mut pdf = p.w * cosine_hemisphere_pdf(-wi.z);
-        if alpha >= DELTA_ALPHA && p.z > 0.0 {
+        if p.z > 0.0 && transmission_is_rough(m, alpha, eta) {
             pdf += specular_transmission_pdf(m, wo, wi, eta, alpha, p.z);
         }
         return pdf;
@@ -338,12 +351,13 @@ pub fn base_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
             }
             thin_reflection(r)
         } else {
-            let h = if alpha >= DELTA_ALPHA { ggx_sample_vndf(wo, alpha, Vec2::new(u.y, u.z)) } else { Vec3::Z };
+            let rough = transmission_is_rough(m, alpha, eta);
+            let h = if rough { ggx_sample_vndf(wo, alpha, Vec2::new(u.y, u.z)) } else { Vec3::Z };
             let r = refract_dir(wo, h, eta);
             if r.w == 0.0 {
                 return none;
             }
-            if alpha < DELTA_ALPHA {
+            if !rough {
                 let t = transmission_albedo(m, wo.z, eta) / (eta * eta);
                 return BsdfSample { wi: r.truncate(), weight: t / p.z, pdf: p.z, delta: true };
             }
@@ -476,8 +490,10 @@ pub fn bsdf_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
 pub fn bsdf_is_delta(m: &Material, wo: Vec3, eta: f32) -> bool {
     let alpha = m.roughness * m.roughness;
     let p = lobe_probabilities(m, wo.z, eta);
-    let base =
-        p.y <= 0.0 && p.w <= 0.0 && (p.x <= 0.0 || !specular_is_rough(m, alpha)) && (p.z <= 0.0 || alpha < DELTA_ALPHA);
+    let base = p.y <= 0.0
+        && p.w <= 0.0
+        && (p.x <= 0.0 || !specular_is_rough(m, alpha))
+        && (p.z <= 0.0 || !transmission_is_rough(m, alpha, eta));
     if !has_layers(m) {
         return base;
     }
