@@ -41,11 +41,24 @@ pub enum Command {
     /// and BVH traversal throughput. See BENCHMARKS.md and bench/compare-mitsuba.sh.
     Bench(BenchArgs),
     /// List the GPU adapters (Vulkan, Metal, DX12) and their limits, or describe a scene.
-    Info {
-        /// A .gltf/.glb file: print its triangles, meshes, instances, materials, textures,
-        /// lights, extensions and bounds.
-        scene: Option<PathBuf>,
-    },
+    Info(InfoArgs),
+}
+
+#[derive(clap::Args)]
+pub struct InfoArgs {
+    /// A .gltf/.glb file: print what `veach render` would render of it with the same
+    /// --scene, --variant and --camera (triangles, meshes, instances, lights, bounds), and
+    /// its materials, textures and extensions.
+    pub scene: Option<PathBuf>,
+    /// Camera node name (default: the first camera, else a view framing the scene).
+    #[arg(long, requires = "scene")]
+    pub camera: Option<String>,
+    /// The glTF scene, by index (default: the file's default scene).
+    #[arg(long = "scene", id = "scene_index", value_name = "N", requires = "scene")]
+    pub scene_index: Option<usize>,
+    /// The KHR_materials_variants variant, by name (default: the default materials).
+    #[arg(long, value_name = "NAME", requires = "scene")]
+    pub variant: Option<String>,
 }
 
 #[derive(clap::Args)]
@@ -229,9 +242,10 @@ pub struct LookArgs {
     /// Camera node name (default: the first camera, else a view framing the scene).
     #[arg(long)]
     pub camera: Option<String>,
-    /// The glTF scene to render, by index (default: the file's default scene).
-    #[arg(long, value_name = "N")]
-    pub scene: Option<usize>,
+    /// The glTF scene to render, by index (default: the file's default scene). Its id differs
+    /// from the positional scene file's, which shares the word.
+    #[arg(long = "scene", id = "scene_index", value_name = "N")]
+    pub scene_index: Option<usize>,
     /// The KHR_materials_variants variant to render, by name (default: the default materials).
     #[arg(long, value_name = "NAME")]
     pub variant: Option<String>,
@@ -429,7 +443,7 @@ impl LookArgs {
     pub fn apply(&self, settings: &mut veach::Settings) {
         let absolute = |p: &std::path::Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
         settings.camera = self.camera.clone();
-        settings.scene = self.scene;
+        settings.scene = self.scene_index;
         settings.variant = self.variant.clone();
         settings.env_map = self.env.as_deref().map(absolute);
         settings.env_color = self.env_color.map(Into::into);
@@ -444,7 +458,7 @@ impl LookArgs {
     /// --resume, which continues the saved render as it was).
     pub fn any(&self) -> bool {
         self.camera.is_some()
-            || self.scene.is_some()
+            || self.scene_index.is_some()
             || self.variant.is_some()
             || self.env_color.is_some()
             || self.env.is_some()
@@ -452,5 +466,152 @@ impl LookArgs {
             || self.aperture.is_some()
             || self.light_sampler.is_some()
             || self.focus_distance.is_some()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Cli;
+    use clap::CommandFactory;
+    use clap::parser::ValueSource;
+
+    /// A value each argument accepts, by id; an argument missing here fails the test, so a new
+    /// flag cannot be left out of it.
+    fn sample(id: &str, arg: &clap::Arg) -> String {
+        if let Some(v) = arg.get_possible_values().first() {
+            return v.get_name().to_string();
+        }
+        let v = match id {
+            "scene" => "scene.gltf",
+            "parts" => "a.exr",
+            "input" | "resume" | "reference" | "env" => "in.exr",
+            "stats" => "stats.json",
+            "output" | "screenshot" => "out.png",
+            "checkpoint" => "checkpoint.exr",
+            "stats_json" | "json" => "stats.json",
+            "write_scenes" => "scenes",
+            "width" | "height" | "spp" | "frames" | "large_grid" | "tree_emitters" => "4",
+            "max_depth" | "seed" | "scene_index" => "1",
+            "min_samples" => "16",
+            "time" | "checkpoint_every" | "exposure" | "env_strength" | "aperture" | "focus_distance"
+            | "clamp_direct" | "clamp_indirect" | "input_scale" | "render_scale" => "0.5",
+            "noise_threshold" => "0.05",
+            "camera" => "Camera",
+            "variant" => "Winter",
+            "env_color" => "1,0.5,0.25",
+            "window" => "800x600",
+            "sample_range" => "0..4",
+            "tile" => "0,0,8,8",
+            "denoise_quality" => "fast",
+            _ => panic!("no sample value for argument '{id}': add one to args::tests::sample"),
+        };
+        v.to_string()
+    }
+
+    /// The words that give `arg` its sample value on a command line.
+    fn words(arg: &clap::Arg) -> Vec<String> {
+        let id = arg.get_id().as_str();
+        let takes_value = arg.get_action().takes_values();
+        let value = takes_value.then(|| sample(id, arg));
+        match arg.get_long() {
+            Some(long) => std::iter::once(format!("--{long}")).chain(value).collect(),
+            None => value.into_iter().collect(),
+        }
+    }
+
+    /// Every documented argument of a subcommand (not clap's own --help/--version).
+    fn documented(sub: &clap::Command) -> Vec<&clap::Arg> {
+        sub.get_arguments().filter(|a| !matches!(a.get_id().as_str(), "help" | "version")).collect()
+    }
+
+    /// Parses `line` and checks that every id in `given` was read from the command line.
+    fn parses(sub: &str, line: &[String], given: &[&str]) {
+        let argv = ["veach".to_string(), sub.to_string()].into_iter().chain(line.iter().cloned());
+        let matches =
+            Cli::command().try_get_matches_from(argv).unwrap_or_else(|e| panic!("veach {sub} {}: {e}", line.join(" ")));
+        let (_, m) = matches.subcommand().expect("a subcommand");
+        for id in given {
+            assert_eq!(
+                m.value_source(id),
+                Some(ValueSource::CommandLine),
+                "veach {sub} {}: '{id}' did not come from the command line",
+                line.join(" ")
+            );
+        }
+    }
+
+    /// Every flag of every subcommand parses, each alone (with what its subcommand requires)
+    /// and all together (except --resume, which conflicts with the flags that would change
+    /// the render), and lands in its own argument: a clash of names, such as the scene file
+    /// and --scene N sharing one id, fails here, while clap's own check of it runs only in
+    /// debug builds.
+    #[test]
+    fn every_documented_flag_parses_alone_and_together() {
+        let cli = Cli::command();
+        let mut checked = 0;
+        for sub in cli.get_subcommands() {
+            let name = sub.get_name();
+            let args = documented(sub);
+            let required: Vec<&clap::Arg> = args.iter().copied().filter(|a| a.is_required_set()).collect();
+            // Arguments that need another one to be given with them.
+            let companion = |id: &str| -> Vec<&str> {
+                match (name, id) {
+                    ("render", "min_samples") => vec!["noise_threshold"],
+                    ("info", "camera" | "scene_index" | "variant") => vec!["scene"],
+                    _ => vec![],
+                }
+            };
+            let required_line = |skip: &str| -> Vec<String> {
+                let mut line = Vec::new();
+                for r in &required {
+                    if r.get_id().as_str() != skip {
+                        line.extend(words(r));
+                    }
+                }
+                // render's scene file is required unless --resume is given.
+                if name == "render" && skip != "scene" {
+                    line.extend(["scene.gltf".to_string()]);
+                }
+                line
+            };
+            for arg in &args {
+                let id = arg.get_id().as_str();
+                if name == "render" && id == "scene" {
+                    continue; // always in `required_line`
+                }
+                let mut line = required_line(id);
+                let mut given = vec![id];
+                for c in companion(id) {
+                    let other = args.iter().find(|a| a.get_id().as_str() == c).expect("companion argument");
+                    line.extend(words(other));
+                    given.push(c);
+                }
+                line.extend(words(arg));
+                parses(name, &line, &given);
+                checked += 1;
+            }
+            let together: Vec<&clap::Arg> = args.iter().copied().filter(|a| a.get_id().as_str() != "resume").collect();
+            let line: Vec<String> = together.iter().flat_map(|a| words(a)).collect();
+            let ids: Vec<&str> = together.iter().map(|a| a.get_id().as_str()).collect();
+            parses(name, &line, &ids);
+        }
+        assert!(checked > 60, "only {checked} arguments checked");
+    }
+
+    /// The case that was broken: the positional scene file beside --scene N, both spellings.
+    #[test]
+    fn scene_file_and_scene_index_are_separate_arguments() {
+        use clap::Parser;
+        for flag in [&["--scene", "1"][..], &["--scene=1"][..]] {
+            let argv = ["veach", "render", "MultipleScenes.gltf"].iter().chain(flag).chain(&["-o", "a.png"]);
+            let cli = Cli::try_parse_from(argv).unwrap_or_else(|e| panic!("{flag:?}: {e}"));
+            let super::Command::Render(r) = cli.command else { panic!("not render") };
+            assert_eq!(r.scene.as_deref(), Some(std::path::Path::new("MultipleScenes.gltf")));
+            assert_eq!(r.look.scene_index, Some(1));
+        }
+        let cli = Cli::try_parse_from(["veach", "info", "m.gltf", "--scene", "1", "--variant", "v", "--camera", "c"])
+            .unwrap_or_else(|e| panic!("info: {e}"));
+        let super::Command::Info(i) = cli.command else { panic!("not info") };
+        assert_eq!((i.scene_index, i.variant.as_deref(), i.camera.as_deref()), (Some(1), Some("v"), Some("c")));
     }
 }

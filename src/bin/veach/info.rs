@@ -1,12 +1,18 @@
 //! `veach info`: the GPU adapters and their limits, or a scene's contents.
 
-use std::path::Path;
+use crate::args::InfoArgs;
 use veach::Error;
 
-pub fn run(scene: Option<&Path>) -> Result<(), Error> {
-    if let Some(path) = scene {
-        println!("{}", veach::scene::gltf::describe_file(path)?);
-        let loaded = veach::load(path, None)?;
+pub fn run(args: &InfoArgs) -> Result<(), Error> {
+    if let Some(path) = args.scene.as_deref() {
+        let choice = veach::scene::gltf::Choice { scene: args.scene_index, variant: args.variant.clone() };
+        println!("{}", veach::scene::gltf::describe_file(path, &choice, args.camera.as_deref())?);
+        let options = veach::LoadOptions {
+            camera: args.camera.as_deref(),
+            scene: args.scene_index,
+            variant: args.variant.as_deref(),
+        };
+        let loaded = veach::load_with(path, &options)?;
         if !loaded.scene.textures.is_empty() {
             let atlas = veach::packed::pack_textures(&loaded.scene.textures);
             let images: u64 = loaded.scene.textures.iter().map(|t| t.width as u64 * t.height as u64 * 4).sum();

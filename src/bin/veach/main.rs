@@ -62,7 +62,7 @@ fn main() -> ExitCode {
         #[cfg(feature = "bench")]
         args::Command::Bench(a) => done(bench::run(&a)),
         args::Command::PlotConvergence(a) => done(plot::run(&a)),
-        args::Command::Info { scene } => done(info::run(scene.as_deref())),
+        args::Command::Info(a) => done(info::run(&a)),
     };
     match result {
         Ok(Outcome::Done) => ExitCode::SUCCESS,
