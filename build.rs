@@ -9,8 +9,11 @@ fn main() {
     println!("cargo::rerun-if-env-changed=VK_DRIVER_FILES");
     let icd_dirs = ["/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d", "/usr/local/share/vulkan/icd.d"];
     for d in icd_dirs {
-        println!("cargo::rerun-if-changed={d}");
+        watch(std::path::Path::new(d));
     }
+    // Installing a driver through the package manager also writes its database: one file,
+    // so a single timestamp to compare, on Debian and its kin.
+    watch_file(std::path::Path::new("/var/lib/dpkg/status"));
     // CI requires the GPU tests to run (and fail without an adapter), never to be ignored.
     println!("cargo::rerun-if-env-changed=VEACH_REQUIRE_GPU");
     let required = std::env::var("VEACH_REQUIRE_GPU").is_ok_and(|v| v == "1");
@@ -29,5 +32,30 @@ fn main() {
         .any(|d| std::path::Path::new(d).join("libvulkan.so.1").exists());
     if !(icd && loader) {
         println!("cargo::rustc-cfg=veach_no_gpu");
+    }
+}
+
+/// Re-probe when `dir` changes. Cargo re-runs a build script on every build when a watched path
+/// does not exist, so a missing directory is watched through its nearest existing ancestor
+/// (creating it changes that ancestor) — unless that ancestor is a top-level system directory
+/// (/, /etc, /usr, /usr/share, /usr/local, /usr/local/share), which cargo would scan whole and
+/// which changes for unrelated reasons; the package database covers those.
+fn watch(dir: &std::path::Path) {
+    let too_wide = ["/", "/etc", "/usr", "/usr/share", "/usr/local", "/usr/local/share"];
+    let mut p = Some(dir);
+    while let Some(d) = p {
+        if d.exists() {
+            if d == dir || !too_wide.iter().any(|w| d == std::path::Path::new(w)) {
+                println!("cargo::rerun-if-changed={}", d.display());
+            }
+            return;
+        }
+        p = d.parent();
+    }
+}
+
+fn watch_file(file: &std::path::Path) {
+    if file.is_file() {
+        println!("cargo::rerun-if-changed={}", file.display());
     }
 }
