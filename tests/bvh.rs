@@ -129,3 +129,70 @@ fn zero_area_triangles_stay_out_of_the_tree() {
     assert!(order.iter().copied().eq(0..4000u32), "every triangle is packed once");
     check(&scene, 5_000, &mut rng);
 }
+
+/// The AVX2 walk (eight children a node in one pass, POPCNT/LZCNT), which `trace` runs on CPUs
+/// that have it, finds the baseline walk's hits bit for bit — same triangle, t, u, v — and the
+/// same occlusion answers: random rays through triangle soups (sparse, dense, and a deep tree
+/// of 200k), the bundled scenes, axis-parallel and grazing rays, and rays that start on a
+/// surface.
+#[test]
+#[cfg_attr(not(target_arch = "x86_64"), ignore = "the AVX2 walk exists on x86-64 only")]
+fn the_avx2_walk_finds_the_baseline_walks_hits() {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use veach::cpu::bvh::{trace, trace_baseline, wide_walk_available};
+        assert!(wide_walk_available(), "this CPU has no AVX2: the wide walk cannot be tested here");
+        let mut rng = Lcg(41);
+        let mut scenes = vec![soup(300, &mut rng), soup(3000, &mut rng), soup(200_000, &mut rng)];
+        for name in ["cornell-box.gltf", "cornell-glass.gltf", "furnace-a080.gltf", "veach-mis.gltf"] {
+            scenes.push(common::load_pair(&common::asset(name), None).expect("asset loads").0);
+        }
+        let (mut compared, mut hits) = (0, 0);
+        for scene in &scenes {
+            let packed = PackedScene::new(scene);
+            let b = scene.bounds();
+            let (lo, size) = (b.min - 0.2 * b.diagonal(), 1.4 * b.diagonal());
+            for k in 0..20_000 {
+                let tri =
+                    &packed.triangles[(rng.f() * packed.triangles.len() as f32) as usize % packed.triangles.len()];
+                let (p0, e1, e2) = (Vec3::from(tri.p0), Vec3::from(tri.e1), Vec3::from(tri.e2));
+                let (a, c) = (rng.f(), rng.f());
+                let on_surface = p0 + e1 * a.min(1.0 - c) + e2 * c.min(1.0 - a);
+                let mut dir = (rng.v() * 2.0 - 1.0).normalize();
+                let origin = match k % 4 {
+                    0 | 1 => lo + rng.v() * size,
+                    2 => on_surface,
+                    _ => {
+                        // Grazing: along the triangle's plane, from just off it.
+                        dir = (e1 * (rng.f() - 0.5) + e2 * (rng.f() - 0.5)).normalize();
+                        on_surface - dir * size.length() * 0.5
+                    }
+                };
+                if k % 7 == 0 {
+                    let axis = (rng.f() * 3.0) as usize % 3;
+                    dir[axis] = 0.0;
+                    dir = dir.normalize();
+                }
+                if !dir.is_finite() {
+                    continue;
+                }
+                let ray = Ray { origin, dir };
+                let (wide, base) = (trace(&packed, &ray, INF, false), trace_baseline(&packed, &ray, INF, false));
+                let bits = |h: &veach::cpu::bvh::Hit| (h.t.to_bits(), h.tri, h.u.to_bits(), h.v.to_bits(), h.instance);
+                assert_eq!(bits(&wide), bits(&base), "ray {origin} {dir}: AVX2 {wide:?} vs baseline {base:?}");
+                for t_max in [INF, base.t * 1.0001, base.t * 0.9999, 0.5] {
+                    let (w, b) = (trace(&packed, &ray, t_max, true), trace_baseline(&packed, &ray, t_max, true));
+                    assert_eq!(w.tri != NO_HIT, b.tri != NO_HIT, "ray {origin} {dir} t_max {t_max}: occlusion differs");
+                    assert_eq!(
+                        bits(&w),
+                        bits(&b),
+                        "ray {origin} {dir} t_max {t_max}: any-hit AVX2 {w:?} vs baseline {b:?}"
+                    );
+                }
+                compared += 1;
+                hits += (base.tri != NO_HIT) as u32;
+            }
+        }
+        assert!(hits > compared / 5, "the rays should hit often ({hits} of {compared})");
+    }
+}

@@ -100,6 +100,41 @@ pub fn intersect_cw_node(node: &CwNode, origin: Vec3, inv_dir: Vec3, t_max: f32,
     mask
 }
 
+/// `intersect_cw_node` with the eight children in one AVX2 register: per child the same
+/// operations in the same order (multiply, then add; min and max with the same operands
+/// first), so the same mask bit for bit.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn intersect_cw_node_avx2(node: &CwNode, origin: Vec3, inv_dir: Vec3, t_max: f32, oct_inv4: u32) -> u32 {
+    use std::arch::x86_64::*;
+    let e = UVec3::splat(node.e_imask) >> UVec3::new(0, 8, 16) & UVec3::splat(0xff);
+    let scale = Vec3::new(f32::from_bits(e.x << 23), f32::from_bits(e.y << 23), f32::from_bits(e.z << 23)) * inv_dir;
+    let shift = (Vec3::from(node.p) - origin) * inv_dir;
+    // Eight bytes (children 0..8, low byte first) as eight floats.
+    let bytes = |lo: u32, hi: u32| _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_set_epi32(0, 0, hi as i32, lo as i32)));
+    let slab = |q: &[u32; 4], axis: usize| {
+        let (s, sh) = (_mm256_set1_ps(scale[axis]), _mm256_set1_ps(shift[axis]));
+        let t0 = _mm256_add_ps(_mm256_mul_ps(bytes(q[0], q[1]), s), sh);
+        let t1 = _mm256_add_ps(_mm256_mul_ps(bytes(q[2], q[3]), s), sh);
+        (_mm256_min_ps(t0, t1), _mm256_max_ps(t0, t1))
+    };
+    let ((near_x, far_x), (near_y, far_y), (near_z, far_z)) = (slab(&node.qx, 0), slab(&node.qy, 1), slab(&node.qz, 2));
+    let t_enter = _mm256_max_ps(_mm256_max_ps(near_x, near_y), _mm256_max_ps(near_z, _mm256_setzero_ps()));
+    let t_exit = _mm256_min_ps(_mm256_min_ps(far_x, far_y), _mm256_min_ps(far_z, _mm256_set1_ps(t_max)));
+    let mut hits = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(t_enter, t_exit)) as u32;
+    let mut mask = 0;
+    while hits != 0 {
+        let child = hits.trailing_zeros();
+        hits &= hits - 1;
+        let child_meta = (node.child_meta[(child >> 2) as usize] >> (8 * (child & 3))) & 0xff;
+        let is_inner = child_meta & (child_meta << 1) & 0x10 != 0;
+        let bit_index = (child_meta ^ if is_inner { oct_inv4 & 0xff } else { 0 }) & 0x1f;
+        mask |= ((child_meta >> 5) & 7) << bit_index;
+    }
+    mask
+}
+
 /// The four bytes of `w` as floats, low byte first (SSE2 unpacks on x86-64: the scalar
 /// conversions took a tenth of the walk).
 #[inline(always)]
@@ -145,12 +180,64 @@ pub fn octant_inv4(dir: Vec3) -> u32 {
         | (if dir.z < 0.0 { 0 } else { 0x01010101 })
 }
 
+/// Closest (or, with `any_hit`, any) hit of `ray` in the mesh BVH at `root`, better than
+/// `best`. On x86-64 CPUs with AVX2 (checked once, at run time: the binary targets baseline
+/// x86-64) the walk runs compiled for them, testing a node's eight children in one pass and
+/// counting bits with POPCNT/LZCNT; it makes the same decisions in the same order with the same
+/// roundings as the baseline walk (no FMA contraction: Rust never fuses), so hits are the same
+/// bits — tests/bvh.rs holds the two to that.
 pub fn trace_blas(scene: &PackedScene, ray: &Ray, root: u32, best: Hit, any_hit: bool, instance: u32) -> Hit {
+    #[cfg(target_arch = "x86_64")]
+    if wide_walk_available() {
+        // SAFETY: the CPU has the features the function is compiled for (checked just above).
+        return unsafe { trace_blas_avx2(scene, ray, root, best, any_hit, instance) };
+    }
+    trace_blas_walk::<false>(scene, ray, root, best, any_hit, instance)
+}
+
+/// Whether this CPU runs the AVX2 walk (std caches the CPUID answer).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn wide_walk_available() -> bool {
+    std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("popcnt")
+        && std::arch::is_x86_feature_detected!("lzcnt")
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,popcnt,lzcnt")]
+unsafe fn trace_blas_avx2(scene: &PackedScene, ray: &Ray, root: u32, best: Hit, any_hit: bool, instance: u32) -> Hit {
+    trace_blas_walk::<true>(scene, ray, root, best, any_hit, instance)
+}
+
+/// The child mask of a node: eight children at once when `WIDE` (only reached from the AVX2
+/// walk), else four at a time.
+#[inline(always)]
+fn node_mask<const WIDE: bool>(node: &CwNode, origin: Vec3, inv_dir: Vec3, t_max: f32, oct_inv4: u32) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    if WIDE {
+        // SAFETY: WIDE is true only inside `trace_blas_avx2`, called when the CPU has AVX2.
+        return unsafe { intersect_cw_node_avx2(node, origin, inv_dir, t_max, oct_inv4) };
+    }
+    intersect_cw_node(node, origin, inv_dir, t_max, oct_inv4)
+}
+
+/// The walk itself (the shader's loop), for both instruction sets.
+#[inline(always)]
+fn trace_blas_walk<const WIDE: bool>(
+    scene: &PackedScene,
+    ray: &Ray,
+    root: u32,
+    best: Hit,
+    any_hit: bool,
+    instance: u32,
+) -> Hit {
     let triangles: &[Triangle] = &scene.triangles;
     let mut hit = best;
     let inv_dir = safe_inv_dir(ray.dir);
     let oct_inv4 = octant_inv4(ray.dir);
-    let mut stack = [UVec2::ZERO; STACK_SIZE];
+    // Not zero-filled per ray: only entries below `sp` are ever read, each written first.
+    let mut stack = [std::mem::MaybeUninit::<UVec2>::uninit(); STACK_SIZE];
     let mut sp = 0usize;
     let mut group = UVec2::new(root, 0x80000000);
     loop {
@@ -159,12 +246,12 @@ pub fn trace_blas(scene: &PackedScene, ray: &Ray, root: u32, best: Hit, any_hit:
             let child_bit = 31 - hits.leading_zeros();
             group.y = hits & !(1 << child_bit);
             if group.y > 0x00ffffff && sp < STACK_SIZE {
-                stack[sp] = group;
+                stack[sp].write(group);
                 sp += 1;
             }
             let slot = (child_bit - 24) ^ (oct_inv4 & 0xff);
             let node = load_cw_node(scene, group.x + (hits & !(u32::MAX << slot)).count_ones());
-            let mask = intersect_cw_node(node, ray.origin, inv_dir, hit.t, oct_inv4);
+            let mask = node_mask::<WIDE>(node, ray.origin, inv_dir, hit.t, oct_inv4);
             group = UVec2::new(node.child_base, (mask & 0xff000000) | (node.e_imask >> 24));
             let mut tris = mask & 0x00ffffff;
             while tris != 0 {
@@ -186,13 +273,33 @@ pub fn trace_blas(scene: &PackedScene, ray: &Ray, root: u32, best: Hit, any_hit:
                 break;
             }
             sp -= 1;
-            group = stack[sp];
+            // SAFETY: every entry below the stack pointer was written by the push above.
+            group = unsafe { stack[sp].assume_init() };
         }
     }
     hit
 }
 
+/// The baseline walk, whatever the CPU: the reference the AVX2 walk is tested against.
+pub fn trace_baseline(scene: &PackedScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
+    trace_walk(scene, ray, t_max, any_hit, |scene, ray, root, best, any_hit, instance| {
+        trace_blas_walk::<false>(scene, ray, root, best, any_hit, instance)
+    })
+}
+
 pub fn trace(scene: &PackedScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
+    trace_walk(scene, ray, t_max, any_hit, trace_blas)
+}
+
+/// The top-level walk over instances, each instance's mesh walked by `trace_blas`.
+#[inline(always)]
+fn trace_walk(
+    scene: &PackedScene,
+    ray: &Ray,
+    t_max: f32,
+    any_hit: bool,
+    trace_blas: impl Fn(&PackedScene, &Ray, u32, Hit, bool, u32) -> Hit,
+) -> Hit {
     let mut hit = Hit { t: t_max, tri: NO_HIT, u: 0.0, v: 0.0, instance: 0 };
     if scene.instance_count == 0 {
         return trace_blas(scene, ray, 0, hit, any_hit, 0);
