@@ -31,6 +31,7 @@ pub mod bench;
 #[doc(hidden)]
 pub mod cpu;
 pub mod denoise;
+mod engine;
 mod error;
 pub mod exr_layers;
 pub mod film;

@@ -1,6 +1,7 @@
 //! `Renderer`: a packed scene on one engine (the GPU kernel or the CPU reference),
 //! accumulating samples progressively into a film.
 
+use crate::engine::{Engine, GpuEngine};
 use crate::film::Film;
 use crate::packed::PackedScene;
 use crate::params::Params;
@@ -19,17 +20,11 @@ fn make_params(scene: &PackedScene, camera: &Camera, settings: &Settings, tile: 
     params
 }
 
-enum Engine {
-    /// The GPU engine, and the host copy of the scene for host ray queries.
-    Gpu(Box<gpu::GpuRenderer>, Box<PackedScene>),
-    Cpu(Box<cpu::Renderer>),
-}
-
 /// A scene ready to render with one engine, accumulating samples progressively.
 pub struct Renderer {
     params: Params,
     settings: Settings,
-    engine: Engine,
+    engine: Box<dyn Engine>,
     environment_source: EnvironmentSource,
 }
 
@@ -94,34 +89,25 @@ impl Renderer {
         let environment = settings.environment(&scene.scene_environment, scene.has_lights())?;
         scene.set_environment(&environment);
         let params = make_params(&scene, camera, settings, settings.window());
-        let engine = match ctx {
-            None => Engine::Cpu(Box::new(cpu::Renderer::new(scene, params))),
-            Some(ctx) => Engine::Gpu(Box::new(gpu::GpuRenderer::new(ctx, &scene, params)?), Box::new(scene)),
+        let engine: Box<dyn Engine> = match ctx {
+            None => Box::new(cpu::Renderer::new(scene, params)),
+            Some(ctx) => Box::new(GpuEngine { renderer: gpu::GpuRenderer::new(ctx, &scene, params)?, scene }),
         };
         Ok(Renderer { params, settings: settings.clone(), engine, environment_source })
     }
 
     pub fn backend(&self) -> Backend {
-        match self.engine {
-            Engine::Gpu(..) => Backend::Gpu,
-            Engine::Cpu(_) => Backend::Cpu,
-        }
+        self.engine.backend()
     }
 
     /// The engine and its device, for logs and statistics.
     pub fn adapter_name(&self) -> String {
-        match &self.engine {
-            Engine::Gpu(g, _) => g.adapter_name(),
-            Engine::Cpu(_) => format!("cpu ({} threads)", rayon::current_num_threads()),
-        }
+        self.engine.adapter_name()
     }
 
     /// The packed scene (host copy), for host ray queries and statistics.
     pub fn scene(&self) -> &PackedScene {
-        match &self.engine {
-            Engine::Gpu(_, scene) => scene,
-            Engine::Cpu(c) => c.scene(),
-        }
+        self.engine.scene()
     }
 
     #[doc(hidden)]
@@ -141,10 +127,7 @@ impl Renderer {
 
     /// Bytes of device memory held (0 on the CPU engine).
     pub fn gpu_bytes(&self) -> u64 {
-        match &self.engine {
-            Engine::Gpu(g, _) => g.gpu_bytes,
-            Engine::Cpu(_) => 0,
-        }
+        self.engine.gpu_bytes()
     }
 
     /// Accumulates sample indices `start .. start + count` into the film.
@@ -152,13 +135,7 @@ impl Renderer {
         if start.checked_add(count).is_none() {
             return Err(Error::Input(format!("sample indices {start}+{count} overflow")));
         }
-        match &mut self.engine {
-            Engine::Gpu(g, _) => g.render_samples(start, count),
-            Engine::Cpu(c) => {
-                c.render_samples(start, count);
-                Ok(())
-            }
-        }
+        self.engine.render_samples(start, count)
     }
 
     /// Accumulates sample `sample` for film rows `y0 .. y0 + rows` only: the viewer's way to
@@ -167,30 +144,18 @@ impl Renderer {
         if !y0.is_multiple_of(ROW_BAND) || !rows.is_multiple_of(ROW_BAND) {
             return Err(Error::Input(format!("row band {y0}+{rows} is not aligned to {ROW_BAND} rows")));
         }
-        match &mut self.engine {
-            Engine::Gpu(g, _) => g.render_rows(sample, y0, rows),
-            Engine::Cpu(c) => {
-                c.render_rows(sample, y0, rows);
-                Ok(())
-            }
-        }
+        self.engine.render_rows(sample, y0, rows)
     }
 
     /// The accumulated film (a readback on the GPU).
     pub fn film(&self) -> Result<Film, Error> {
-        match &self.engine {
-            Engine::Gpu(g, _) => g.read_film(),
-            Engine::Cpu(c) => Ok(c.film().clone()),
-        }
+        self.engine.film()
     }
 
     /// The fraction of pixels that stopped sampling (None: not an adaptive render). A
     /// readback of one word a pixel on the GPU.
     pub fn converged_fraction(&self) -> Result<Option<f64>, Error> {
-        match &self.engine {
-            Engine::Gpu(g, _) => g.converged_fraction(),
-            Engine::Cpu(c) => Ok(c.film().converged_fraction()),
-        }
+        self.engine.converged_fraction()
     }
 
     /// Restarts accumulation with a new camera and settings (same scene and environment):
@@ -198,10 +163,7 @@ impl Renderer {
     pub fn reset(&mut self, camera: &Camera, settings: &Settings) -> Result<(), Error> {
         settings.validate()?;
         let params = make_params(self.scene(), camera, settings, settings.window());
-        match &mut self.engine {
-            Engine::Gpu(g, _) => g.reset(params)?,
-            Engine::Cpu(c) => c.reset(params),
-        }
+        self.engine.reset(params)?;
         (self.params, self.settings) = (params, settings.clone());
         Ok(())
     }
@@ -209,19 +171,10 @@ impl Renderer {
     /// Replaces the environment (a new sky keeps the BVH and the device's geometry) and
     /// restarts accumulation.
     pub fn set_environment(&mut self, camera: &Camera, environment: &Environment) -> Result<(), Error> {
-        let window = self.settings.window();
-        match &mut self.engine {
-            Engine::Gpu(g, scene) => {
-                scene.set_environment(environment);
-                self.params = make_params(scene, camera, &self.settings, window);
-                g.set_environment(scene, self.params)?;
-            }
-            Engine::Cpu(c) => {
-                c.set_environment(environment);
-                self.params = make_params(c.scene(), camera, &self.settings, window);
-                c.reset(self.params);
-            }
-        }
+        let settings = &self.settings;
+        let window = settings.window();
+        self.params =
+            self.engine.set_environment(environment, &|scene| make_params(scene, camera, settings, window))?;
         self.environment_source = EnvironmentSource::Settings;
         Ok(())
     }
@@ -239,10 +192,7 @@ impl Renderer {
 
     /// The GPU engine, when rendering there (the viewer displays its film in place).
     pub fn gpu(&self) -> Option<&gpu::GpuRenderer> {
-        match &self.engine {
-            Engine::Gpu(g, _) => Some(g),
-            Engine::Cpu(_) => None,
-        }
+        self.engine.gpu()
     }
 
     /// Replaces the accumulated film (resume); it must match the render window.
@@ -263,10 +213,7 @@ impl Renderer {
         if film.layout != layout || film.data.len() != layout.words(film.pixel_count()) {
             return Err(Error::Input("the film's AOVs do not match the render's".into()));
         }
-        match &mut self.engine {
-            Engine::Gpu(g, _) => g.upload_film(film),
-            Engine::Cpu(c) => c.set_film(film),
-        }
+        self.engine.set_film(film);
         Ok(())
     }
 }
