@@ -2,7 +2,8 @@
 //! load and BVH-build times, device memory per triangle, and the BVH's traversal throughput
 //! for primary, shadow and diffuse-bounce rays. Timing only: nothing here asserts.
 
-use crate::cpu::bvh::{Ray, intersect_closest, offset_ray};
+use crate::cpu::bvh::{intersect_closest, offset_ray};
+use crate::cpu::common::Ray;
 use crate::cpu::frame::{frame_from_normal, from_local};
 use crate::cpu::sampling::sample_cosine_hemisphere;
 use crate::packed::PackedScene;

@@ -306,7 +306,7 @@ fn shared_constants_have_the_same_values() {
         ("MAX_SAMPLE", veach::film::MAX_SAMPLE as f64),
         ("PAGE_ROW_LOG2", veach::gpu::PAGE_ROW_LOG2 as f64),
         ("NO_HIT", veach::cpu::bvh::NO_HIT as f64),
-        ("INF", veach::cpu::bvh::INF as f64),
+        ("INF", veach::cpu::common::INF as f64),
         ("DELTA_ALPHA", veach::cpu::bsdf::DELTA_ALPHA as f64),
         ("CLEARCOAT_F0", veach::cpu::clearcoat::CLEARCOAT_F0 as f64),
         ("SHEEN_MIN_ROUGHNESS", veach::sheen::SHEEN_MIN_ROUGHNESS as f64),
@@ -316,7 +316,7 @@ fn shared_constants_have_the_same_values() {
         ("UNIFORM_HEMISPHERE_PDF", veach::cpu::sampling::UNIFORM_HEMISPHERE_PDF as f64),
         ("SOLID_ANGLE_MIN", veach::cpu::spherical_triangle::SOLID_ANGLE_MIN as f64),
         ("SOLID_ANGLE_MAX", veach::cpu::spherical_triangle::SOLID_ANGLE_MAX as f64),
-        ("ONE_MINUS_EPSILON", veach::cpu::light_tree::ONE_MINUS_EPSILON as f64),
+        ("ONE_MINUS_EPSILON", veach::cpu::common::ONE_MINUS_EPSILON as f64),
         ("ALL_CHANNELS", veach::cpu::integrator::ALL_CHANNELS as f64),
     ];
     let mut wrong = Vec::new();

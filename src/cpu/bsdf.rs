@@ -3,6 +3,7 @@
 //! under KHR_materials_sheen's sheen and KHR_materials_clearcoat's coat.
 
 use super::clearcoat::{coat_alpha, coat_eval, coat_pdf, coat_sample, coat_weight};
+use super::common::luminance;
 use super::iridescence::iridescence_fresnel;
 use super::microfacet::{
     ggx_d, ggx_d_aniso, ggx_g1, ggx_g2, ggx_g2_aniso, ggx_reflection_pdf, ggx_reflection_pdf_aniso, ggx_sample_vndf,
@@ -11,7 +12,7 @@ use super::microfacet::{
 use super::sampling::{
     UNIFORM_HEMISPHERE_PDF, cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere,
 };
-use crate::packed::{MAT_THIN_WALLED, Material, luminance};
+use crate::packed::{MAT_THIN_WALLED, Material};
 use crate::sheen::{sheen_albedo, sheen_albedo_scaling, sheen_brdf};
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::FRAC_1_PI;

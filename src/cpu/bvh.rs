@@ -1,5 +1,6 @@
 //! Twin of `shaders/bvh.wgsl`: the same traversal over the same nodes.
 
+pub use super::common::{INF, Ray};
 use super::instance::{load_instance, transform_dir, transform_point};
 use super::material::alpha_passes;
 use crate::packed::{BvhNode, CwNode, PackedScene, TRI_ALPHA, Triangle};
@@ -9,13 +10,6 @@ pub const NO_HIT: u32 = u32::MAX;
 // One group per tree level: accel refuses deeper mesh BVHs.
 const STACK_SIZE: usize = crate::accel::MAX_DEPTH as usize;
 pub const TLAS_STACK_SIZE: usize = 64;
-pub const INF: f32 = 3.4e38;
-
-#[derive(Clone, Copy, Debug)]
-pub struct Ray {
-    pub origin: Vec3,
-    pub dir: Vec3,
-}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {

@@ -1,6 +1,6 @@
 //! Twin of `shaders/camera.wgsl`.
 
-use super::bvh::Ray;
+use super::common::Ray;
 use super::sampler::{Sampler, sample_2d, sampler_init};
 use super::sampling::sample_uniform_disk;
 use crate::params::{PROJECTION_ORTHOGRAPHIC, Params};

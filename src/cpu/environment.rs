@@ -1,7 +1,8 @@
 //! Twin of `shaders/environment.wgsl`.
 
+use super::common::luminance;
 use super::sampling::{UNIFORM_SPHERE_PDF, sample_uniform_sphere};
-use crate::packed::{PackedScene, luminance};
+use crate::packed::PackedScene;
 use crate::params::Params;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};

@@ -1,8 +1,9 @@
 //! Twin of `shaders/integrator.wgsl`: the path tracer, sample for sample.
 
 use super::bsdf::{bsdf_albedo, bsdf_eval, bsdf_is_delta, bsdf_pdf, bsdf_sample};
-use super::bvh::{INF, NO_HIT, Ray, intersect_closest, occluded, offset_ray};
+use super::bvh::{NO_HIT, intersect_closest, occluded, offset_ray};
 use super::camera::camera_sample;
+use super::common::{INF, Ray};
 use super::environment::{environment_pdf, environment_radiance};
 use super::frame::{Frame, frame_from_normal, from_local, to_local};
 use super::instance::world_triangle;

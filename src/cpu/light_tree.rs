@@ -1,7 +1,6 @@
 //! Twin of `shaders/light_tree.wgsl`: walking the light BVH (`accel/light_bvh.rs`) from the
 //! root with one random number, and the exact probability of choosing an emitter.
 
-use super::lights::light_entry;
 use crate::packed::{LIGHT_LEAF, LIGHT_NODE_ROWS, LIGHT_TWO_SIDED, LightGroup, PackedScene};
 use crate::params::Params;
 use glam::{BVec4A, Vec2, Vec3, Vec4};
@@ -33,8 +32,7 @@ pub struct LightNode {
     pub two_sided: bool,
 }
 
-/// The largest f32 below 1: rescaled numbers stay in [0, 1).
-pub const ONE_MINUS_EPSILON: f32 = 0.99999994;
+use super::common::ONE_MINUS_EPSILON;
 
 pub fn load_light_node(scene: &PackedScene, params: &Params, node: u32) -> LightNode {
     let base = (params.tree_base + LIGHT_NODE_ROWS * node) as usize;
@@ -124,9 +122,9 @@ pub fn node_importance(ctx: &LightContext, node: &LightNode) -> Vec2 {
 pub fn child_importance(scene: &PackedScene, params: &Params, ctx: &LightContext, node: &LightNode) -> Vec2 {
     let importance = node_importance(ctx, node);
     if importance.x > 0.0 && node.leaf && !node.two_sided && node.index < params.light_count {
-        let tri = &scene.triangles[light_entry(scene, node.index).triangle as usize];
-        let n = Vec3::from(tri.e1).cross(Vec3::from(tri.e2));
-        if n.dot(ctx.point - Vec3::from(tri.p0)) <= 0.0 {
+        // The emitter triangle's plane (p0, e1 × e2), as packed for the group walk.
+        let [p0, n] = scene.light_planes[node.index as usize];
+        if n.dot(ctx.point - p0) <= 0.0 {
             return Vec2::ZERO;
         }
     }

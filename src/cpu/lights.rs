@@ -1,8 +1,8 @@
 //! Twin of `shaders/lights.wgsl`.
 
-use super::bvh::INF;
+use super::common::{INF, ONE_MINUS_EPSILON};
 use super::environment::{environment_pdf, environment_radiance, sample_environment};
-use super::light_tree::{LightContext, ONE_MINUS_EPSILON, light_tree_pmf, sample_light_tree};
+use super::light_tree::{LightContext, light_tree_pmf, sample_light_tree};
 use super::material::{material_at, triangle_uv};
 use super::sampling::{bilinear_pdf, sample_bilinear, sample_uniform_triangle};
 use super::spherical_triangle::{

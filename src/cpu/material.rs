@@ -1,12 +1,12 @@
 //! Twin of `shaders/material.wgsl`: textured material, alpha and the normal-mapped shading normal.
 
-use super::bvh::Ray;
+use super::common::{Ray, oct_decode};
 use super::instance::{load_instance, transform_dir, transform_normal};
 use super::rng::pcg_hash;
 use super::texture::sample_texture;
 use crate::packed::{
     MAT_ALPHA_MASK, Material, NO_TEXTURE, PackedScene, TRI_HAS_NORMALS, TRI_HAS_TANGENTS, TRI_MIRRORED,
-    TRI_TANGENT_SIGN_SHIFT, TextureRef, Triangle, oct_decode,
+    TRI_TANGENT_SIGN_SHIFT, TextureRef, Triangle,
 };
 use glam::{Vec2, Vec3, Vec4};
 

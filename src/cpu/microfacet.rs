@@ -1,6 +1,6 @@
 //! Twin of `shaders/microfacet.wgsl`: GGX with height-correlated Smith masking and VNDF sampling.
 
-use super::bvh::INF;
+use super::common::INF;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 

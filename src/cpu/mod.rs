@@ -7,6 +7,7 @@ pub mod bsdf;
 pub mod bvh;
 pub mod camera;
 pub mod clearcoat;
+pub mod common;
 pub mod environment;
 pub mod frame;
 pub mod instance;

@@ -1,6 +1,6 @@
 //! Twin of `shaders/sampling.wgsl`.
 
-use super::light_tree::ONE_MINUS_EPSILON;
+use super::common::ONE_MINUS_EPSILON;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
 

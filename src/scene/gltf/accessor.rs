@@ -4,12 +4,9 @@
 //! decoded once by `Views::new`). Every size is checked against its view before anything is
 //! allocated or read.
 
-use super::MAX_TRIANGLES;
+use super::MAX_ELEMENTS;
 use gltf::accessor::DataType;
 use std::collections::HashMap;
-
-/// The most elements one accessor may have (three vertices per triangle of the limit).
-pub const MAX_ELEMENTS: usize = 3 * MAX_TRIANGLES;
 
 /// The bytes of every buffer view: a slice of its buffer, or its decoded bytes when the view
 /// is stored compressed.

@@ -5,7 +5,8 @@
 //! decoder's limits bound what a stream may claim, and the decoded counts must match the
 //! accessors'.
 
-use super::accessor::{MAX_ELEMENTS, Views};
+use super::MAX_ELEMENTS;
+use super::accessor::Views;
 use gltf::accessor::DataType;
 use std::collections::HashMap;
 

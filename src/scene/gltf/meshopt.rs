@@ -39,7 +39,7 @@ fn decode(ext: &Value, khr: bool, view_length: usize, buffers: &[gltf::buffer::D
     if size > view_length {
         return Err(format!("{count} × {stride} bytes do not fit the view's {view_length}"));
     }
-    if count > super::accessor::MAX_ELEMENTS {
+    if count > super::MAX_ELEMENTS {
         return Err(format!("{count} elements, above the limit"));
     }
     let mut out = vec![0u8; size];

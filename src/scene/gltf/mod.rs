@@ -30,6 +30,9 @@ use std::path::Path;
 
 /// Refuse scenes beyond this before allocating for them (hostile counts).
 pub const MAX_TRIANGLES: usize = 64 << 20;
+/// The most elements one accessor (or decoded stream) may have: three vertices per triangle
+/// of the limit.
+pub const MAX_ELEMENTS: usize = 3 * MAX_TRIANGLES;
 /// Largest glTF/GLB file or buffer accepted.
 pub const MAX_FILE_BYTES: u64 = 4 << 30;
 /// Most node visits while flattening the hierarchy (shared subtrees multiply).
