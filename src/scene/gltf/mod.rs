@@ -12,7 +12,7 @@ mod mesh;
 mod meshopt;
 mod resources;
 
-pub use describe::describe_file;
+pub use describe::{Description, describe_file, describe_scene};
 pub use extensions::SUPPORTED_EXTENSIONS;
 pub use image::MAX_DECODED_IMAGE_SIDE;
 pub use material::uv_transform;
