@@ -50,6 +50,7 @@ pub mod scene;
 mod settings;
 #[doc(hidden)]
 pub mod sheen;
+mod stats;
 mod tile;
 pub mod tonemap;
 #[cfg(feature = "viewer")]
@@ -66,4 +67,5 @@ pub use scene::{Camera, Environment, EnvironmentMap, Scene};
 pub use settings::{
     Backend, EnvironmentSource, LightSampler, MAX_FILM_BYTES, MAX_IMAGE_SIDE, SamplerKind, Settings, Strategy,
 };
+pub use stats::{extend_stats, render_stats};
 pub use tile::Tile;

@@ -395,7 +395,7 @@ fn render(
     settings.validate().map_err(value_err)?;
     let backend = parse_backend(backend)?;
     let job = Job { scene: scene.path.clone(), settings: settings.clone(), sample_start: 0, sample_end: spp };
-    let (loaded, path) = (&scene.loaded, &scene.path);
+    let loaded = &scene.loaded;
     // Ctrl-C (or the progress callback's exception) stops the loop after the chunk in flight.
     let mut stopped: Option<PyErr> = None;
     let result = py.detach(|| -> Result<(Film, Option<Vec<f32>>, serde_json::Value), veach::Error> {
@@ -444,49 +444,20 @@ fn render(
         let window = settings.window();
         let pixels = window.width as f64 * window.height as f64;
         let rendered = if film.is_adaptive() { film.mean_spp() * pixels } else { p.done as f64 * pixels };
-        let stopped_by = if p.done >= spp {
-            "samples"
-        } else if p.converged.is_some_and(|c| c >= 1.0) {
-            "converged"
-        } else if stopped.is_some() {
-            "interrupt"
-        } else {
-            "time"
-        };
-        let s = &settings;
-        let stats = serde_json::json!({
-            "scene": path.display().to_string(),
-            "width": s.width,
-            "height": s.height,
-            "spp": film.samples(),
-            "spp_target": spp,
-            "mean_spp": film.mean_spp(),
-            "noise_threshold": s.noise_threshold,
-            "converged_fraction": film.converged_fraction(),
+        let mut stats = veach::render_stats(&job, &film, &renderer, &p, p.stopped_by(stopped.is_some()));
+        let more = serde_json::json!({
             "interrupted": stopped.is_some(),
-            "stopped_by": stopped_by,
             "time_budget": time,
-            "max_depth": s.max_depth,
-            "seed": s.seed,
-            "strategy": s.strategy,
-            "sampler": s.sampler,
-            "light_sampler": s.light_sampler,
-            "environment": renderer.environment_source(),
-            "biased": s.biased(),
-            "adapter": renderer.adapter_name(),
-            "backend": format!("{:?}", renderer.backend()).to_lowercase(),
             "backend_reason": reason,
             "seconds_total": t0.elapsed().as_secs_f64(),
-            "seconds_render": p.seconds,
             "samples_per_second": rendered / p.seconds.max(1e-9),
             "triangles": triangles,
             "bvh_nodes": bvh_nodes,
             "bvh_depth": bvh_depth,
-            "nonfinite_samples": film.nonfinite_samples(),
-            "aovs": s.aovs,
             "denoise_quality": denoise.then(|| quality.name()),
             "denoise_seconds": denoise_seconds,
         });
+        veach::extend_stats(&mut stats, more);
         Ok((film, denoised, stats))
     });
     let (film, denoised, stats) = result.map_err(py_err)?;

@@ -158,16 +158,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
     }
     // Short of the target: the budget ran out (a finished render) or a signal came (saved, exit 130).
     let interrupted = !progress.finished() && INTERRUPTED.load(Ordering::SeqCst);
-    let converged = progress.converged.is_some_and(|c| c >= 1.0);
-    let stopped_by = if done >= total {
-        "samples"
-    } else if converged {
-        "converged"
-    } else if interrupted {
-        "interrupt"
-    } else {
-        "time"
-    };
+    let stopped_by = progress.stopped_by(interrupted);
     let film = renderer.film()?;
     let seconds_render = progress.seconds;
     bar.finish_and_clear();
@@ -228,60 +219,31 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
         );
     }
     if let Some(path) = &args.stats_json {
-        let s = &job.settings;
-        let mut stats = serde_json::json!({
-            "scene": job.scene.display().to_string(),
-            "width": s.width,
-            "height": s.height,
-            "tile": s.tile,
-            "spp": film.samples(),
-            "spp_target": total,
-            "mean_spp": film.mean_spp(),
-            "noise_threshold": s.noise_threshold,
-            "min_samples": s.adaptive().then(|| s.adaptive_min_samples()),
-            "converged_fraction": film.converged_fraction(),
-            "sample_start": job.sample_start,
+        let mut stats = veach::render_stats(&job, &film, &renderer, &progress, stopped_by);
+        // (Several objects: serde_json's macro has a recursion limit.)
+        let more = serde_json::json!({
             "interrupted": interrupted,
-            "stopped_by": stopped_by,
             "time_budget": args.time,
-            "max_depth": s.max_depth,
-            "seed": s.seed,
-            "strategy": s.strategy,
-            "sampler": s.sampler,
-            "light_sampler": s.light_sampler,
-            "environment": renderer.environment_source(),
-            "clamp_direct": s.clamp_direct,
-            "clamp_indirect": s.clamp_indirect,
-            "biased": s.biased(),
             "light_tree_nodes": light_tree.0,
             "light_tree_depth": light_tree.1,
             "light_tree_build_seconds": light_tree.2,
-            "adapter": renderer.adapter_name(),
-            "backend": format!("{:?}", renderer.backend()).to_lowercase(),
             "backend_reason": backend_reason,
             "seconds_total": t0.elapsed().as_secs_f64(),
-            "seconds_render": seconds_render,
             "samples_per_second": samples_per_second,
             "triangles": triangles,
             "bvh_nodes": bvh_nodes,
             "bvh_depth": bvh_depth,
             "bvh_build_seconds": bvh_seconds,
-            "nonfinite_samples": nonfinite,
-            "gpu_bytes": renderer.gpu_bytes(),
             "reference": args.reference.as_ref().map(|p| p.display().to_string()),
             "convergence": convergence,
         });
-        // (A second object: serde_json's macro has a recursion limit.)
         let denoise = serde_json::json!({
-            "aovs": s.aovs,
             "denoise_quality": args.denoise.then(|| args.denoise_quality.name()),
             "denoise_engine": args.denoise.then_some(denoise_engine),
             "denoise_seconds": denoise_seconds,
         });
-        for more in [denoise, textures] {
-            if let (Some(all), serde_json::Value::Object(more)) = (stats.as_object_mut(), more) {
-                all.extend(more);
-            }
+        for m in [more, denoise, textures] {
+            veach::extend_stats(&mut stats, m);
         }
         veach::output::write_atomic(path, serde_json::to_string_pretty(&stats).unwrap_or_default().as_bytes())?;
     }
