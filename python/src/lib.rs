@@ -273,58 +273,6 @@ impl Image {
     }
 }
 
-/// What `render` needs from Python besides the scene.
-#[derive(Clone)]
-struct Look {
-    strategy: Option<String>,
-    sampler: Option<String>,
-    light_sampler: Option<String>,
-    aovs: Vec<String>,
-    env_map: Option<PathBuf>,
-    env_color: Option<[f32; 3]>,
-    env_strength: f32,
-    clamp_direct: Option<f32>,
-    clamp_indirect: Option<f32>,
-    aperture: f32,
-    focus_distance: Option<f32>,
-}
-
-fn settings_of(scene: &Scene, width: u32, height: u32, max_depth: u32, seed: u32, look: Look) -> PyResult<Settings> {
-    let mut s = Settings {
-        width,
-        height,
-        max_depth,
-        seed,
-        camera: scene.camera.clone(),
-        scene: scene.scene,
-        variant: scene.variant.clone(),
-        env_color: look.env_color,
-        env_strength: look.env_strength,
-        clamp_direct: look.clamp_direct,
-        clamp_indirect: look.clamp_indirect,
-        aperture: look.aperture,
-        focus_distance: look.focus_distance,
-        ..Settings::default()
-    };
-    if let Some(m) = look.env_map {
-        must_exist(&m)?;
-        s.env_map = Some(std::fs::canonicalize(&m).unwrap_or(m));
-    }
-    if let Some(n) = &look.strategy {
-        s.strategy = parse_name("strategy", n, "bsdf, light, mis-balance or mis-power")?;
-    }
-    if let Some(n) = &look.sampler {
-        s.sampler = parse_name("sampler", n, "sobol or independent")?;
-    }
-    if let Some(n) = &look.light_sampler {
-        s.light_sampler = parse_name("light sampler", n, "tree or power")?;
-    }
-    for a in &look.aovs {
-        s.aovs.push(parse_name("AOV", a, "albedo, normal or depth")?);
-    }
-    Ok(s)
-}
-
 /// Renders `scene`; the Python wrapper documents the arguments.
 #[pyfunction]
 #[pyo3(signature = (
@@ -361,22 +309,40 @@ fn render(
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Py<Image>> {
     let t0 = Instant::now();
-    let look = Look {
-        strategy,
-        sampler,
-        light_sampler,
-        aovs,
-        env_map,
+    let mut settings = Settings {
+        width,
+        height,
+        max_depth,
+        seed,
+        camera: scene.camera.clone(),
+        scene: scene.scene,
+        variant: scene.variant.clone(),
         env_color,
         env_strength,
         clamp_direct,
         clamp_indirect,
         aperture,
         focus_distance,
+        noise_threshold,
+        min_samples,
+        ..Settings::default()
     };
-    let mut settings = settings_of(&scene, width, height, max_depth, seed, look)?;
-    settings.noise_threshold = noise_threshold;
-    settings.min_samples = min_samples;
+    if let Some(m) = env_map {
+        must_exist(&m)?;
+        settings.env_map = Some(std::fs::canonicalize(&m).unwrap_or(m));
+    }
+    if let Some(n) = &strategy {
+        settings.strategy = parse_name("strategy", n, "bsdf, light, mis-balance or mis-power")?;
+    }
+    if let Some(n) = &sampler {
+        settings.sampler = parse_name("sampler", n, "sobol or independent")?;
+    }
+    if let Some(n) = &light_sampler {
+        settings.light_sampler = parse_name("light sampler", n, "tree or power")?;
+    }
+    for a in &aovs {
+        settings.aovs.push(parse_name("AOV", a, "albedo, normal or depth")?);
+    }
     let quality: veach::denoise::Quality = denoise_quality.parse().map_err(value_err)?;
     // The denoiser reads the albedo and the normal.
     if denoise {
