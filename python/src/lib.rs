@@ -491,11 +491,8 @@ fn denoise(py: Python<'_>, image: PyRef<'_, Image>, quality: &str, backend: &str
     let film = &image.film;
     let (denoised, engine_name) = py
         .detach(|| -> Result<_, veach::Error> {
-            // auto: the CPU twin, which outruns a software adapter's kernel; `gpu` asks for the device.
-            let ctx = match backend {
-                Backend::Gpu => Some(veach::gpu::GpuContext::new()?),
-                _ => None,
-            };
+            // As `veach denoise`: auto takes a hardware GPU, else the CPU twin.
+            let (ctx, _) = veach::denoise::device(backend)?;
             let engine = ctx.as_ref().map_or(veach::denoise::Engine::Cpu, veach::denoise::Engine::Gpu);
             let options = veach::denoise::Options { quality, ..Default::default() };
             Ok((veach::denoise::denoise_film(film, &options, engine)?, engine.name()))

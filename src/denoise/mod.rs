@@ -130,6 +130,23 @@ impl Engine<'_> {
     }
 }
 
+/// The device the network runs on (None: the CPU twin), and why: `auto` takes a hardware GPU
+/// and otherwise the CPU, whose twin outruns a software adapter's kernel.
+pub fn device(backend: crate::Backend) -> Result<(Option<crate::gpu::GpuContext>, String), Error> {
+    match backend {
+        crate::Backend::Cpu => Ok((None, "requested".into())),
+        crate::Backend::Gpu => Ok((Some(crate::gpu::GpuContext::new()?), "requested".into())),
+        crate::Backend::Auto => match crate::gpu::adapter_info() {
+            Ok(info) if info.device_type != wgpu::DeviceType::Cpu => {
+                Ok((Some(crate::gpu::GpuContext::new()?), format!("auto: hardware GPU adapter ({})", info.name)))
+            }
+            Ok(info) => Ok((None, format!("auto: the only GPU adapter ({}) is a software one", info.name))),
+            Err(Error::NoAdapter(_)) => Ok((None, "auto: no GPU adapter".into())),
+            Err(e) => Err(e),
+        },
+    }
+}
+
 /// Denoises `images` on `engine`.
 pub fn denoise(images: &Images, options: &Options, engine: Engine) -> Result<Vec<f32>, Error> {
     images.validate().map_err(Error::Input)?;

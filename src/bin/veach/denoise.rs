@@ -3,27 +3,8 @@
 
 use crate::args::DenoiseArgs;
 use std::time::Instant;
-use veach::Backend;
 use veach::Error;
 use veach::denoise::{Engine, Images, Options};
-use veach::gpu::GpuContext;
-
-/// The device the network runs on (None: the CPU twin), and why: `auto` takes a hardware GPU
-/// and otherwise the CPU, whose twin outruns a software adapter's kernel.
-fn device(backend: Backend) -> Result<(Option<GpuContext>, String), Error> {
-    match backend {
-        Backend::Cpu => Ok((None, "requested".into())),
-        Backend::Gpu => Ok((Some(GpuContext::new()?), "requested".into())),
-        Backend::Auto => match veach::gpu::adapter_info() {
-            Ok(info) if info.device_type != wgpu::DeviceType::Cpu => {
-                Ok((Some(GpuContext::new()?), format!("auto: hardware GPU adapter ({})", info.name)))
-            }
-            Ok(info) => Ok((None, format!("auto: the only GPU adapter ({}) is a software one", info.name))),
-            Err(Error::NoAdapter(_)) => Ok((None, "auto: no GPU adapter".into())),
-            Err(e) => Err(e),
-        },
-    }
-}
 use veach::output::Format;
 
 pub fn run(args: &DenoiseArgs) -> Result<(), Error> {
@@ -37,7 +18,7 @@ pub fn run(args: &DenoiseArgs) -> Result<(), Error> {
         normal: layers.normal.as_deref(),
     };
     let options = Options { quality: args.denoise_quality, input_scale: args.input_scale, max_tile_pixels: None };
-    let (ctx, reason) = device(args.backend)?;
+    let (ctx, reason) = veach::denoise::device(args.backend)?;
     let engine = ctx.as_ref().map_or(Engine::Cpu, Engine::Gpu);
     let start = Instant::now();
     let out = veach::denoise::denoise(&images, &options, engine).map_err(|e| match e {
