@@ -21,6 +21,36 @@ fn soup(count: usize, rng: &mut Lcg) -> Scene {
     Scene { triangles, materials: vec![Material::default()], ..Default::default() }
 }
 
+/// A soup whose triangles take turns between an opaque material, a BLEND one (alpha 0.5: hit
+/// by a hash of the ray) and a MASK one under its cutoff (never hit), so that the leaf test's
+/// alpha path is walked.
+fn alpha_soup(count: usize, rng: &mut Lcg) -> Scene {
+    let mut scene = soup(count, rng);
+    for (i, t) in scene.triangles.iter_mut().enumerate() {
+        t.material = (i % 3) as u32;
+    }
+    let blend = Material { alpha: 0.5, alpha_mode: veach::scene::AlphaMode::Blend, ..Default::default() };
+    let mask = Material { alpha: 0.3, alpha_mode: veach::scene::AlphaMode::Mask(0.5), ..Default::default() };
+    scene.materials = vec![Material::default(), blend, mask];
+    scene
+}
+
+/// Forty placements of one soup mesh (some mirrored, scaled, turned) beside a world mesh:
+/// the walk through the top level and into each instance's mesh.
+fn instanced_soup(rng: &mut Lcg) -> Scene {
+    let mut scene = soup(200, rng);
+    let mesh = soup(500, rng).triangles;
+    scene.meshes.push(veach::scene::Mesh { name: "soup".into(), triangles: mesh });
+    for k in 0..40 {
+        let offset = rng.v() * 20.0 - 5.0;
+        let scale = Vec3::new(if k % 5 == 0 { -1.0 } else { 1.0 }, 0.5 + rng.f(), 1.0);
+        let rotation = glam::Quat::from_axis_angle((rng.v() - 0.5).normalize_or(Vec3::Y), rng.f() * 6.0);
+        let transform = glam::Mat4::from_scale_rotation_translation(scale, rotation, offset);
+        scene.instances.push(veach::scene::Instance { mesh: 0, transform });
+    }
+    scene
+}
+
 fn check(scene: &Scene, rays: usize, rng: &mut Lcg) {
     check_with(scene, rays, rng, |rng| (rng.v() * 2.0 - 1.0).normalize());
 }
@@ -130,11 +160,11 @@ fn zero_area_triangles_stay_out_of_the_tree() {
     check(&scene, 5_000, &mut rng);
 }
 
-/// The AVX2 walk (eight children a node in one pass, POPCNT/LZCNT), which `trace` runs on CPUs
-/// that have it, finds the baseline walk's hits bit for bit — same triangle, t, u, v — and the
-/// same occlusion answers: random rays through triangle soups (sparse, dense, and a deep tree
-/// of 200k), the bundled scenes, axis-parallel and grazing rays, and rays that start on a
-/// surface.
+/// The AVX2 walk (eight children a node in one pass, POPCNT/LZCNT, leaf triangles eight at a
+/// time), which `trace` runs on CPUs that have it, finds the baseline walk's hits bit for bit —
+/// same triangle, t, u, v — and the same occlusion answers: random rays through triangle soups
+/// (sparse, dense, a deep tree of 200k, alpha-masked and blended, instanced and mirrored), the
+/// bundled scenes, axis-parallel and grazing rays, and rays that start on a surface.
 #[test]
 #[cfg_attr(not(target_arch = "x86_64"), ignore = "the AVX2 walk exists on x86-64 only")]
 fn the_avx2_walk_finds_the_baseline_walks_hits() {
@@ -144,6 +174,8 @@ fn the_avx2_walk_finds_the_baseline_walks_hits() {
         assert!(wide_walk_available(), "this CPU has no AVX2: the wide walk cannot be tested here");
         let mut rng = Lcg(41);
         let mut scenes = vec![soup(300, &mut rng), soup(3000, &mut rng), soup(200_000, &mut rng)];
+        scenes.push(alpha_soup(3000, &mut rng));
+        scenes.push(instanced_soup(&mut rng));
         for name in ["cornell-box.gltf", "cornell-glass.gltf", "furnace-a080.gltf", "veach-mis.gltf"] {
             scenes.push(common::load_pair(&common::asset(name), None).expect("asset loads").0);
         }
@@ -182,7 +214,12 @@ fn the_avx2_walk_finds_the_baseline_walks_hits() {
                 assert_eq!(bits(&wide), bits(&base), "ray {origin} {dir}: AVX2 {wide:?} vs baseline {base:?}");
                 for t_max in [INF, base.t * 1.0001, base.t * 0.9999, 0.5] {
                     let (w, b) = (trace(&packed, &ray, t_max, true), trace_baseline(&packed, &ray, t_max, true));
-                    assert_eq!(w.tri != NO_HIT, b.tri != NO_HIT, "ray {origin} {dir} t_max {t_max}: occlusion differs");
+                    assert_eq!(
+                        w.tri != NO_HIT,
+                        b.tri != NO_HIT,
+                        "scene {} ray {origin} {dir} t_max {t_max}: occlusion differs {w:?} {b:?}",
+                        packed.triangles.len()
+                    );
                     assert_eq!(
                         bits(&w),
                         bits(&b),

@@ -129,6 +129,108 @@ unsafe fn intersect_cw_node_avx2(node: &CwNode, origin: Vec3, inv_dir: Vec3, t_m
     mask
 }
 
+/// The leaf triangles `tris` (bits k: triangle `base + k`) of a node against `ray`, eight at a
+/// time from the structure-of-arrays copy: per lane the operations of `intersect_triangle` in
+/// its order (so the same t, u, v bits), its rejections as masks (a NaN fails them as the
+/// scalar comparisons fail). The lanes that beat the closest hit so far are then accepted in
+/// the scalar loop's order — descending k, strictly closer, alpha tested — so the hit is the
+/// one the scalar loop keeps, ties included. Returns true when an any-hit query is answered.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,popcnt,lzcnt")]
+#[inline]
+#[allow(clippy::too_many_arguments)]
+unsafe fn intersect_leaves_avx2(
+    scene: &PackedScene,
+    lanes: Option<&crate::packed::TriangleLanes>,
+    ray: &Ray,
+    base: u32,
+    tris: u32,
+    hit: &mut Hit,
+    any_hit: bool,
+    instance: u32,
+) -> bool {
+    use std::arch::x86_64::*;
+    let Some(lanes) = lanes else { return false };
+    let splat = |x: f32| _mm256_set1_ps(x);
+    let (dx, dy, dz) = (splat(ray.dir.x), splat(ray.dir.y), splat(ray.dir.z));
+    let (ox, oy, oz) = (splat(ray.origin.x), splat(ray.origin.y), splat(ray.origin.z));
+    let (zero, one) = (_mm256_setzero_ps(), splat(1.0));
+    let mut t_out = [0.0f32; 8];
+    let mut u_out = [0.0f32; 8];
+    let mut v_out = [0.0f32; 8];
+    // Chunks of eight from the highest, as the scalar loop takes k from the highest.
+    for chunk in (0..3u32).rev() {
+        let bits = (tris >> (8 * chunk)) & 0xff;
+        if bits == 0 {
+            continue;
+        }
+        let first = (base + 8 * chunk) as usize;
+        // Every component array has TRIANGLE_LANES floats past any triangle, so the slice of
+        // eight exists.
+        // SAFETY: an unaligned load of the eight floats of that slice.
+        let load = |c: usize| unsafe { _mm256_loadu_ps(lanes.component(c, first)[..8].as_ptr()) };
+        let (p0x, p0y, p0z) = (load(0), load(1), load(2));
+        let (e1x, e1y, e1z) = (load(3), load(4), load(5));
+        let (e2x, e2y, e2z) = (load(6), load(7), load(8));
+        let mul = |a, b| _mm256_mul_ps(a, b);
+        let sub = |a, b| _mm256_sub_ps(a, b);
+        let add = |a, b| _mm256_add_ps(a, b);
+        // glam's cross and dot, term by term: (a.y b.z − b.y a.z, ...), (x x' + y y') + z z'.
+        let cross = |ax, ay, az, bx, by, bz| {
+            (sub(mul(ay, bz), mul(by, az)), sub(mul(az, bx), mul(bz, ax)), sub(mul(ax, by), mul(bx, ay)))
+        };
+        let dot = |ax, ay, az, bx, by, bz| add(add(mul(ax, bx), mul(ay, by)), mul(az, bz));
+        let (px, py, pz) = cross(dx, dy, dz, e2x, e2y, e2z);
+        let det = dot(e1x, e1y, e1z, px, py, pz);
+        let inv_det = _mm256_div_ps(one, det);
+        let (tx, ty, tz) = (sub(ox, p0x), sub(oy, p0y), sub(oz, p0z));
+        let u = mul(dot(tx, ty, tz, px, py, pz), inv_det);
+        let (qx, qy, qz) = cross(tx, ty, tz, e1x, e1y, e1z);
+        let v = mul(dot(dx, dy, dz, qx, qy, qz), inv_det);
+        let t = mul(dot(e2x, e2y, e2z, qx, qy, qz), inv_det);
+        // det != 0, 0 <= u <= 1, !(v < 0), !(u + v > 1).
+        let ok = _mm256_and_ps(
+            _mm256_and_ps(_mm256_cmp_ps::<_CMP_NEQ_UQ>(det, zero), _mm256_cmp_ps::<_CMP_GE_OQ>(u, zero)),
+            _mm256_cmp_ps::<_CMP_LE_OQ>(u, one),
+        );
+        let ok = _mm256_and_ps(
+            _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_NLT_UQ>(v, zero)),
+            _mm256_cmp_ps::<_CMP_NGT_UQ>(add(u, v), one),
+        );
+        // What intersect_triangle returns: (INF, 0, 0) when a test above fails, (INF, u, v)
+        // when only t > 0 does (a miss, yet `hit.t` above INF would take it, as the scalar
+        // loop does).
+        let inf = splat(INF);
+        let u = _mm256_and_ps(u, ok);
+        let v = _mm256_and_ps(v, ok);
+        let t = _mm256_blendv_ps(inf, t, _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GT_OQ>(t, zero)));
+        let mut candidates = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(t, splat(hit.t))) as u32 & bits;
+        if candidates == 0 {
+            continue;
+        }
+        // SAFETY: stores of eight floats into arrays of eight.
+        unsafe {
+            _mm256_storeu_ps(t_out.as_mut_ptr(), t);
+            _mm256_storeu_ps(u_out.as_mut_ptr(), u);
+            _mm256_storeu_ps(v_out.as_mut_ptr(), v);
+        }
+        while candidates != 0 {
+            let k = 31 - candidates.leading_zeros();
+            candidates &= !(1 << k);
+            let i = base + 8 * chunk + k;
+            let (t, u, v) = (t_out[k as usize], u_out[k as usize], v_out[k as usize]);
+            let tri = &scene.triangles[i as usize];
+            if t < hit.t && (tri.flags & TRI_ALPHA == 0 || alpha_passes(scene, i, u, v, ray)) {
+                *hit = Hit { t, tri: i, u, v, instance };
+                if any_hit {
+                    return true;
+                }
+            }
+        }
+    }
+    false
+}
+
 /// The four bytes of `w` as floats, low byte first (SSE2 unpacks on x86-64: the scalar
 /// conversions took a tenth of the walk).
 #[inline(always)]
@@ -227,6 +329,8 @@ fn trace_blas_walk<const WIDE: bool>(
     instance: u32,
 ) -> Hit {
     let triangles: &[Triangle] = &scene.triangles;
+    #[cfg(target_arch = "x86_64")]
+    let lanes = if WIDE { Some(scene.triangle_lanes()) } else { None };
     let mut hit = best;
     let inv_dir = safe_inv_dir(ray.dir);
     let oct_inv4 = octant_inv4(ray.dir);
@@ -248,6 +352,16 @@ fn trace_blas_walk<const WIDE: bool>(
             let mask = node_mask::<WIDE>(node, ray.origin, inv_dir, hit.t, oct_inv4);
             group = UVec2::new(node.child_base, (mask & 0xff000000) | (node.e_imask >> 24));
             let mut tris = mask & 0x00ffffff;
+            #[cfg(target_arch = "x86_64")]
+            if WIDE && tris != 0 {
+                // SAFETY: WIDE is true only inside `trace_blas_avx2`, called when the CPU has AVX2.
+                if unsafe {
+                    intersect_leaves_avx2(scene, lanes, ray, node.primitive_base, tris, &mut hit, any_hit, instance)
+                } {
+                    return hit;
+                }
+                tris = 0;
+            }
             while tris != 0 {
                 let k = 31 - tris.leading_zeros();
                 tris &= !(1 << k);

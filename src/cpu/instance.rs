@@ -4,9 +4,11 @@ use crate::packed::{INSTANCE_MIRRORED, Instance, PackedScene, TRI_MIRRORED, Tria
 use glam::{Vec3, Vec4};
 
 /// The record of instance `k` (the kernel finds it through params.instance_base, the same value).
-pub fn load_instance(scene: &PackedScene, k: u32) -> Instance {
+/// Borrowed, not copied: the walk and the hit's shading read it several times per hit.
+#[inline(always)]
+pub fn load_instance(scene: &PackedScene, k: u32) -> &Instance {
     let base = (scene.instance_base + 4 * k) as usize;
-    bytemuck::cast_slice::<_, Instance>(&scene.nodes[base..base + 4])[0]
+    &bytemuck::cast_slice::<_, Instance>(&scene.nodes[base..base + 4])[0]
 }
 
 pub fn transform_point(m: &[[f32; 4]; 3], p: Vec3) -> Vec3 {

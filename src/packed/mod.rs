@@ -13,6 +13,7 @@ mod lights;
 mod materials;
 mod octahedral;
 mod textures;
+mod triangle_lanes;
 
 pub use crate::accel::{BvhNode, CwNode, INSTANCE_MIRRORED, Instance};
 pub use features::Features;
@@ -24,6 +25,7 @@ pub use textures::{
     MAX_PAGE_SIDE, MAX_PAGES, Placement, TEXTURE_BUDGET_BYTES, TextureAtlas, atlas_sizes, pack_textures,
     pack_textures_within, shelf_pack,
 };
+pub use triangle_lanes::{TRIANGLE_LANES, TriangleLanes};
 
 use crate::accel::{self, cw_slots};
 use crate::scene::{Environment, Scene};
@@ -54,6 +56,8 @@ pub struct PackedScene {
     /// Instance records, the world mesh's (identity) included; 0 without instancing.
     pub instance_count: u32,
     pub triangles: Vec<Triangle>,
+    /// `triangles` as a structure of arrays for the CPU walk (`triangle_lanes()`).
+    pub(crate) triangle_lanes: std::sync::OnceLock<TriangleLanes>,
     pub attributes: Vec<Attributes>,
     /// First record of the triangles' extra vertex data (COLOR_0, TEXCOORD_1) in
     /// `attributes`, one a triangle in the same order (`geometry::pack_extras`); 0: none.
@@ -250,6 +254,7 @@ impl PackedScene {
                 (nodes_len - instance_base as usize) as u32 / 4
             },
             triangles,
+            triangle_lanes: std::sync::OnceLock::new(),
             attributes,
             extras_base,
             materials,
@@ -299,6 +304,11 @@ impl PackedScene {
     }
 
     /// Whether the scene has an emitter of its own: an emissive triangle or a punctual light.
+    /// The triangles as a structure of arrays, made on first use (the CPU walk's leaf test).
+    pub fn triangle_lanes(&self) -> &TriangleLanes {
+        self.triangle_lanes.get_or_init(|| TriangleLanes::new(&self.triangles))
+    }
+
     pub fn has_lights(&self) -> bool {
         !self.lights.is_empty() || self.punctual_count > 0
     }
