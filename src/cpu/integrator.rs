@@ -1,7 +1,7 @@
 //! Twin of `shaders/integrator.wgsl`: the path tracer, sample for sample.
 
 use super::bsdf::{bsdf_albedo, bsdf_eval, bsdf_is_delta, bsdf_pdf, bsdf_sample};
-use super::bvh::{NO_HIT, intersect_closest, occluded, offset_ray};
+use super::bvh::{Hit, NO_HIT, intersect_closest, occluded, offset_ray};
 use super::camera::camera_sample;
 use super::common::{INF, Ray};
 use super::environment::{environment_pdf, environment_radiance};
@@ -75,195 +75,310 @@ pub fn clamp_contribution(params: &Params, c: Vec3, segments: u32) -> Vec3 {
     if sum > limit { c * (limit / sum) } else { c }
 }
 
+/// A path between its vertices: everything the path tracer carries from one bounce to the
+/// next. The stages below (`path_escaped`, `path_surface`, `path_next_event`, `path_scatter`)
+/// each advance it by one step of `li`, so a scalar loop over them is the reference integrator
+/// and an engine running paths in lanes can run each stage over many paths.
+#[derive(Clone, Debug)]
+pub struct PathState {
+    pub ray: Ray,
+    pub radiance: Vec3,
+    pub beta: Vec3,
+    /// Path segments so far (Mitsuba's depth): 1 after the camera ray's hit.
+    pub depth: u32,
+    /// The previous vertex's BSDF sample: its density and whether it was a Dirac one.
+    pub prev_pdf: f32,
+    pub prev_delta: bool,
+    /// The previous vertex as light selection saw it (for the tree's probability on a hit).
+    pub prev_ctx: LightContext,
+    /// The AOVs look through Dirac surfaces, weighted by the path's own throughput there.
+    pub aov_open: bool,
+    pub aov_weight: Vec3,
+    pub aov: AovSample,
+    /// The colour channel a dispersive surface chose (ALL_CHANNELS before one).
+    pub channel: u32,
+    pub sampler: Sampler,
+}
+
+impl PathState {
+    /// A path starting along `camera_ray`, drawing from `sampler`.
+    pub fn new(params: &Params, camera_ray: Ray, sampler: Sampler) -> PathState {
+        PathState {
+            ray: camera_ray,
+            radiance: Vec3::ZERO,
+            beta: Vec3::ONE,
+            depth: 0,
+            prev_pdf: 0.0,
+            prev_delta: true,
+            prev_ctx: LightContext { point: Vec3::ZERO, normal: Vec3::Z, reflect_only: false },
+            aov_open: params.aov_base > 0,
+            aov_weight: Vec3::ONE,
+            aov: AovSample::default(),
+            channel: ALL_CHANNELS,
+            sampler,
+        }
+    }
+}
+
+/// The surface at a path's vertex, as `path_surface` prepares it for light and BSDF sampling.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceVertex {
+    /// The material at the point (textures applied, the path's dispersion ior, the coat
+    /// normal and anisotropy direction in the local frame).
+    pub mat: Material,
+    pub point: Vec3,
+    /// Geometric normal on the side the ray arrived from.
+    pub ng: Vec3,
+    /// Relative ior across the surface from the arriving side.
+    pub eta: f32,
+    pub frame: Frame,
+    pub wo: Vec3,
+    pub ctx: LightContext,
+}
+
+/// The strategy of the direct-lighting estimator (`params.strategy`).
+pub fn path_strategy(params: &Params) -> Strategy {
+    Strategy::try_from(params.strategy).unwrap_or(Strategy::MisPower)
+}
+
+/// The path's ray left the scene: the environment, weighted by MIS against the environment's
+/// light sample when the previous vertex could have sampled it.
+#[inline(always)]
+pub fn path_escaped(scene: &PackedScene, params: &Params, path: &mut PathState) {
+    let strategy = path_strategy(params);
+    let mut w = 1.0;
+    if path.depth > 1 && !path.prev_delta && params.env_select > 0.0 {
+        match strategy {
+            Strategy::Light => w = 0.0,
+            Strategy::Bsdf => {}
+            _ => w = mis_weight(strategy, path.prev_pdf, environment_pdf(scene, params, path.ray.dir)),
+        }
+    }
+    path.radiance +=
+        clamp_contribution(params, path.beta * environment_radiance(scene, params, path.ray.dir) * w, path.depth);
+}
+
+/// The path's ray hit a surface: absorption inside a volume it leaves, emission (MIS-weighted
+/// against the previous vertex's light sample), the dispersion channel, the shading frame and
+/// the AOVs. None when the path ends here (its last segment).
+#[inline(always)]
+pub fn path_surface(scene: &PackedScene, params: &Params, path: &mut PathState, hit: &Hit) -> Option<SurfaceVertex> {
+    let strategy = path_strategy(params);
+    let ray = path.ray;
+    let depth = path.depth;
+    let tri = &world_triangle(scene, hit.tri, hit.instance);
+    let uv = triangle_uv(scene, hit.tri, hit.u, hit.v);
+    let color = vertex_color(scene, hit.tri, hit.u, hit.v);
+    let mut mat = material_at(scene, &scene.materials[tri.material as usize], uv, color);
+    let m = &mat;
+    let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
+    let point = Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2;
+    let ng_cross = e1.cross(e2).normalize();
+    let ng_raw = if tri.flags & TRI_MIRRORED != 0 { -ng_cross } else { ng_cross };
+    let cos_hit = ray.dir.dot(ng_raw);
+    let attenuation = Vec3::from(m.attenuation);
+    if cos_hit > 0.0 && attenuation.max_element() > 0.0 {
+        path.beta *= (-attenuation * hit.t).exp();
+    }
+    let emission = Vec3::from(m.emission);
+
+    if cos_hit < 0.0 && emission.max_element() > 0.0 {
+        let mut w = 1.0;
+        if depth > 1 && !path.prev_delta {
+            match strategy {
+                Strategy::Light => w = 0.0,
+                Strategy::Bsdf => {}
+                _ => {
+                    w = mis_weight(
+                        strategy,
+                        path.prev_pdf,
+                        light_pdf(scene, params, &path.prev_ctx, tri, ray.dir, hit.t * hit.t, cos_hit),
+                    )
+                }
+            }
+        }
+        path.radiance += clamp_contribution(params, path.beta * emission * w, depth);
+    }
+    let last = params.max_depth != 0 && depth >= params.max_depth;
+    if last && !path.aov_open {
+        return None;
+    }
+
+    // KHR_materials_dispersion: a refracting solid bends each colour its own way. From its
+    // first such surface on, the path follows one channel, chosen uniformly and weighted
+    // 3× (the others dropped): an unbiased estimate of every channel.
+    if mat.dispersion > 0.0 && mat.transmission > 0.0 && mat.flags & MAT_THIN_WALLED == 0 {
+        if path.channel == ALL_CHANNELS {
+            path.channel = ((sample_1d(&mut path.sampler) * 3.0) as u32).min(2);
+            let mut mask = Vec3::ZERO;
+            mask[path.channel as usize] = 3.0;
+            path.beta *= mask;
+        }
+        mat.ior = dispersed_ior(mat.ior, mat.dispersion, path.channel);
+    }
+    let m = &mat;
+    let ng = if cos_hit > 0.0 { -ng_raw } else { ng_raw };
+    // A thin wall has air on both sides.
+    let eta = if cos_hit < 0.0 || m.flags & MAT_THIN_WALLED != 0 { m.ior } else { 1.0 / m.ior };
+    let mut ns = shading_normal(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, m, uv);
+    if ns.dot(ray.dir) > 0.0 {
+        ns = -ns;
+    }
+    let frame = frame_from_normal(ns);
+    let wo = to_local(&frame, -ray.dir);
+    // A coat follows its own normal map, or the interpolated normal when the base's is mapped.
+    if mat.clearcoat > 0.0
+        && (mat.normal_texture.atlas != NO_TEXTURE || mat.clearcoat_normal_texture.atlas != NO_TEXTURE)
+    {
+        let mut nc = coat_normal(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, &mat, uv);
+        if nc.dot(ray.dir) > 0.0 {
+            nc = -nc;
+        }
+        mat.coat_normal = to_local(&frame, nc).into();
+    }
+    // Anisotropy turns with the tangent frame; without tangents the lobe stays isotropic.
+    if mat.anisotropy > 0.0 {
+        let d = to_local(&frame, anisotropy_direction(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ns, &mat, uv));
+        let len = (d.x * d.x + d.y * d.y).sqrt();
+        if len > 1e-6 {
+            mat.anisotropy_tangent = [d.x / len, d.y / len];
+        } else {
+            mat.anisotropy = 0.0;
+        }
+    }
+    let m = &mat;
+    if path.aov_open {
+        if depth == 1 {
+            path.aov.depth = hit.t;
+        }
+        path.aov.albedo = (path.aov_weight * bsdf_albedo(m, wo, eta)).clamp(Vec3::ZERO, Vec3::ONE);
+        path.aov.normal = ns;
+        path.aov_open = bsdf_is_delta(m, wo, eta);
+    }
+    if last {
+        return None;
+    }
+    let ctx = LightContext { point, normal: ns, reflect_only: m.transmission <= 0.0 && m.diffuse_transmission <= 0.0 };
+    Some(SurfaceVertex { mat, point, ng, eta, frame, wo, ctx })
+}
+
+/// Whether next-event estimation runs at a vertex. With the BSDF strategy alone it still runs
+/// for the tree's Dirac lights, which nothing else can find.
+#[inline(always)]
+pub fn next_event_wanted(params: &Params) -> bool {
+    let nee_lights = if params.light_sampler == LIGHT_SAMPLER_TREE { params.tree_emitters } else { params.light_count };
+    if path_strategy(params) == Strategy::Bsdf {
+        params.light_sampler == LIGHT_SAMPLER_TREE && params.tree_emitters > params.light_count
+    } else {
+        nee_lights > 0 || params.env_select > 0.0
+    }
+}
+
+/// Next-event estimation at the vertex: one light sample (and one of the separately sampled
+/// punctual lights), each connected by a shadow ray and weighted by MIS.
+#[inline(always)]
+pub fn path_next_event(scene: &PackedScene, params: &Params, path: &mut PathState, sv: &SurfaceVertex) {
+    let strategy = path_strategy(params);
+    let m = &sv.mat;
+    if next_event_wanted(params) {
+        let u0 = sample_1d(&mut path.sampler);
+        let u12 = sample_2d(&mut path.sampler);
+        let ls = sample_light(scene, params, &sv.ctx, Vec3::new(u0, u12.x, u12.y));
+        path_connect_light(scene, params, strategy, path, sv, &ls);
+    }
+    if params.separate_punctuals > 0 {
+        let ls = sample_punctual(scene, params, sv.point, sample_1d(&mut path.sampler));
+        let c = path.beta * connect(scene, m, &sv.frame, sv.wo, sv.eta, sv.point, sv.ng, &ls) / ls.pdf.max(1e-30);
+        path.radiance += clamp_contribution(params, c, path.depth + 1);
+    }
+}
+
+/// The light sample `ls` of next-event estimation, connected and weighted into the path's
+/// radiance.
+#[inline(always)]
+pub fn path_connect_light(
+    scene: &PackedScene,
+    params: &Params,
+    strategy: Strategy,
+    path: &mut PathState,
+    sv: &SurfaceVertex,
+    ls: &LightSample,
+) {
+    if ls.delta || strategy != Strategy::Bsdf {
+        let m = &sv.mat;
+        let c = connect(scene, m, &sv.frame, sv.wo, sv.eta, sv.point, sv.ng, ls);
+        if c.max_element() > 0.0 {
+            let w = if strategy == Strategy::Light || ls.delta {
+                1.0
+            } else {
+                mis_weight(strategy, ls.pdf, bsdf_pdf(m, sv.wo, to_local(&sv.frame, ls.wi), sv.eta))
+            };
+            path.radiance += clamp_contribution(params, path.beta * c * (w / ls.pdf), path.depth + 1);
+        }
+    }
+}
+
+/// The BSDF sample that continues the path, then Russian roulette. False when the path ends.
+#[inline(always)]
+pub fn path_scatter(params: &Params, path: &mut PathState, sv: &SurfaceVertex) -> bool {
+    let m = &sv.mat;
+    let u0 = sample_1d(&mut path.sampler);
+    let u12 = sample_2d(&mut path.sampler);
+    let bs = bsdf_sample(m, sv.wo, Vec3::new(u0, u12.x, u12.y), sv.eta);
+    if bs.pdf <= 0.0 {
+        return false;
+    }
+    let wi = from_local(&sv.frame, bs.wi);
+    if !same_side(wi, sv.ng, bs.wi) {
+        return false;
+    }
+    path.beta *= bs.weight;
+    if path.aov_open {
+        path.aov_weight *= bs.weight;
+    }
+    if path.beta.max_element() <= 0.0 {
+        return false;
+    }
+    path.prev_pdf = bs.pdf;
+    path.prev_delta = bs.delta;
+    path.prev_ctx = sv.ctx;
+    path.ray = Ray { origin: spawn_point(sv.point, sv.ng, wi), dir: wi };
+
+    if path.depth >= params.rr_depth {
+        let q = path.beta.max_element().min(0.95);
+        if sample_1d(&mut path.sampler) >= q {
+            return false;
+        }
+        path.beta /= q;
+    }
+    true
+}
+
+/// Runs `path` to its end through the stages: the scalar reference integrator.
+pub fn trace_path(scene: &PackedScene, params: &Params, path: &mut PathState) {
+    loop {
+        let hit = intersect_closest(scene, &path.ray);
+        path.depth += 1;
+        if hit.tri == NO_HIT {
+            path_escaped(scene, params, path);
+            return;
+        }
+        let Some(sv) = path_surface(scene, params, path, &hit) else { return };
+        path_next_event(scene, params, path, &sv);
+        if !path_scatter(params, path, &sv) {
+            return;
+        }
+    }
+}
+
 /// Radiance arriving along a camera ray; with AOVs on (`params.aov_base`), what the ray saw of
 /// the first visible surface goes into `aov` (`src/aov.rs`).
 pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut Sampler, aov: &mut AovSample) -> Vec3 {
-    let strategy = Strategy::try_from(params.strategy).unwrap_or(Strategy::MisPower);
-    let mut radiance = Vec3::ZERO;
-    let mut beta = Vec3::ONE;
-    let mut ray = camera_ray;
-    let mut depth = 0u32;
-    let mut prev_pdf = 0.0f32;
-    let mut prev_delta = true;
-    // The previous vertex as light selection saw it (for the tree's probability on a hit).
-    let mut prev_ctx = LightContext { point: Vec3::ZERO, normal: Vec3::Z, reflect_only: false };
-    // The AOVs look through Dirac surfaces, weighted by the path's own throughput there.
-    let mut aov_open = params.aov_base > 0;
-    let mut aov_weight = Vec3::ONE;
-    let mut channel = ALL_CHANNELS;
-    loop {
-        let hit = intersect_closest(scene, &ray);
-        depth += 1;
-        if hit.tri == NO_HIT {
-            let mut w = 1.0;
-            if depth > 1 && !prev_delta && params.env_select > 0.0 {
-                match strategy {
-                    Strategy::Light => w = 0.0,
-                    Strategy::Bsdf => {}
-                    _ => w = mis_weight(strategy, prev_pdf, environment_pdf(scene, params, ray.dir)),
-                }
-            }
-            radiance += clamp_contribution(params, beta * environment_radiance(scene, params, ray.dir) * w, depth);
-            break;
-        }
-        let tri = &world_triangle(scene, hit.tri, hit.instance);
-        let uv = triangle_uv(scene, hit.tri, hit.u, hit.v);
-        let color = vertex_color(scene, hit.tri, hit.u, hit.v);
-        let mut mat = material_at(scene, &scene.materials[tri.material as usize], uv, color);
-        let m = &mat;
-        let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
-        let point = Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2;
-        let ng_cross = e1.cross(e2).normalize();
-        let ng_raw = if tri.flags & TRI_MIRRORED != 0 { -ng_cross } else { ng_cross };
-        let cos_hit = ray.dir.dot(ng_raw);
-        let attenuation = Vec3::from(m.attenuation);
-        if cos_hit > 0.0 && attenuation.max_element() > 0.0 {
-            beta *= (-attenuation * hit.t).exp();
-        }
-        let emission = Vec3::from(m.emission);
-
-        if cos_hit < 0.0 && emission.max_element() > 0.0 {
-            let mut w = 1.0;
-            if depth > 1 && !prev_delta {
-                match strategy {
-                    Strategy::Light => w = 0.0,
-                    Strategy::Bsdf => {}
-                    _ => {
-                        w = mis_weight(
-                            strategy,
-                            prev_pdf,
-                            light_pdf(scene, params, &prev_ctx, tri, ray.dir, hit.t * hit.t, cos_hit),
-                        )
-                    }
-                }
-            }
-            radiance += clamp_contribution(params, beta * emission * w, depth);
-        }
-        let last = params.max_depth != 0 && depth >= params.max_depth;
-        if last && !aov_open {
-            break;
-        }
-
-        // KHR_materials_dispersion: a refracting solid bends each colour its own way. From its
-        // first such surface on, the path follows one channel, chosen uniformly and weighted
-        // 3× (the others dropped): an unbiased estimate of every channel.
-        if mat.dispersion > 0.0 && mat.transmission > 0.0 && mat.flags & MAT_THIN_WALLED == 0 {
-            if channel == ALL_CHANNELS {
-                channel = ((sample_1d(sampler) * 3.0) as u32).min(2);
-                let mut mask = Vec3::ZERO;
-                mask[channel as usize] = 3.0;
-                beta *= mask;
-            }
-            mat.ior = dispersed_ior(mat.ior, mat.dispersion, channel);
-        }
-        let m = &mat;
-        let ng = if cos_hit > 0.0 { -ng_raw } else { ng_raw };
-        // A thin wall has air on both sides.
-        let eta = if cos_hit < 0.0 || m.flags & MAT_THIN_WALLED != 0 { m.ior } else { 1.0 / m.ior };
-        let mut ns = shading_normal(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, m, uv);
-        if ns.dot(ray.dir) > 0.0 {
-            ns = -ns;
-        }
-        let frame = frame_from_normal(ns);
-        let wo = to_local(&frame, -ray.dir);
-        // A coat follows its own normal map, or the interpolated normal when the base's is mapped.
-        if mat.clearcoat > 0.0
-            && (mat.normal_texture.atlas != NO_TEXTURE || mat.clearcoat_normal_texture.atlas != NO_TEXTURE)
-        {
-            let mut nc = coat_normal(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ng_raw, &mat, uv);
-            if nc.dot(ray.dir) > 0.0 {
-                nc = -nc;
-            }
-            mat.coat_normal = to_local(&frame, nc).into();
-        }
-        // Anisotropy turns with the tangent frame; without tangents the lobe stays isotropic.
-        if mat.anisotropy > 0.0 {
-            let d =
-                to_local(&frame, anisotropy_direction(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ns, &mat, uv));
-            let len = (d.x * d.x + d.y * d.y).sqrt();
-            if len > 1e-6 {
-                mat.anisotropy_tangent = [d.x / len, d.y / len];
-            } else {
-                mat.anisotropy = 0.0;
-            }
-        }
-        let m = &mat;
-        if aov_open {
-            if depth == 1 {
-                aov.depth = hit.t;
-            }
-            aov.albedo = (aov_weight * bsdf_albedo(m, wo, eta)).clamp(Vec3::ZERO, Vec3::ONE);
-            aov.normal = ns;
-            aov_open = bsdf_is_delta(m, wo, eta);
-        }
-        if last {
-            break;
-        }
-
-        let ctx =
-            LightContext { point, normal: ns, reflect_only: m.transmission <= 0.0 && m.diffuse_transmission <= 0.0 };
-        // Next-event estimation: one light sample. With the BSDF strategy alone it still
-        // runs for the tree's Dirac lights, which nothing else can find.
-        let nee_lights =
-            if params.light_sampler == LIGHT_SAMPLER_TREE { params.tree_emitters } else { params.light_count };
-        let nee = if strategy == Strategy::Bsdf {
-            params.light_sampler == LIGHT_SAMPLER_TREE && params.tree_emitters > params.light_count
-        } else {
-            nee_lights > 0 || params.env_select > 0.0
-        };
-        if nee {
-            let u0 = sample_1d(sampler);
-            let u12 = sample_2d(sampler);
-            let ls = sample_light(scene, params, &ctx, Vec3::new(u0, u12.x, u12.y));
-            if ls.delta || strategy != Strategy::Bsdf {
-                let c = connect(scene, m, &frame, wo, eta, point, ng, &ls);
-                if c.max_element() > 0.0 {
-                    let w = if strategy == Strategy::Light || ls.delta {
-                        1.0
-                    } else {
-                        mis_weight(strategy, ls.pdf, bsdf_pdf(m, wo, to_local(&frame, ls.wi), eta))
-                    };
-                    radiance += clamp_contribution(params, beta * c * (w / ls.pdf), depth + 1);
-                }
-            }
-        }
-        if params.separate_punctuals > 0 {
-            let ls = sample_punctual(scene, params, point, sample_1d(sampler));
-            let c = beta * connect(scene, m, &frame, wo, eta, point, ng, &ls) / ls.pdf.max(1e-30);
-            radiance += clamp_contribution(params, c, depth + 1);
-        }
-
-        let u0 = sample_1d(sampler);
-        let u12 = sample_2d(sampler);
-        let bs = bsdf_sample(m, wo, Vec3::new(u0, u12.x, u12.y), eta);
-        if bs.pdf <= 0.0 {
-            break;
-        }
-        let wi = from_local(&frame, bs.wi);
-        if !same_side(wi, ng, bs.wi) {
-            break;
-        }
-        beta *= bs.weight;
-        if aov_open {
-            aov_weight *= bs.weight;
-        }
-        if beta.max_element() <= 0.0 {
-            break;
-        }
-        prev_pdf = bs.pdf;
-        prev_delta = bs.delta;
-        prev_ctx = ctx;
-        ray = Ray { origin: spawn_point(point, ng, wi), dir: wi };
-
-        if depth >= params.rr_depth {
-            let q = beta.max_element().min(0.95);
-            if sample_1d(sampler) >= q {
-                break;
-            }
-            beta /= q;
-        }
-    }
-    radiance
+    let mut path = PathState::new(params, camera_ray, sampler.clone());
+    trace_path(scene, params, &mut path);
+    *sampler = path.sampler;
+    *aov = path.aov;
+    path.radiance
 }
 
 /// Sample `params.sample_index` of one film pixel; returns the radiance (possibly non-finite)
