@@ -252,7 +252,7 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<Ra
             let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
             let n = e1.cross(e2).normalize();
             let ng = if n.dot(ray.dir) > 0.0 { -n } else { n };
-            (Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2, ng, sampler.clone())
+            (Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2, ng, *sampler)
         })
         .collect();
     let lit = params.light_count > 0 || params.tree_emitters > 0 || params.env_select > 0.0;
@@ -260,7 +260,7 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<Ra
         surface
             .iter()
             .map(|(p, ng, sampler)| {
-                let mut sampler = sampler.clone();
+                let mut sampler = *sampler;
                 let u0 = sample_1d(&mut sampler);
                 let u12 = sample_2d(&mut sampler);
                 let ctx = crate::cpu::light_tree::LightContext { point: *p, normal: *ng, reflect_only: false };
@@ -284,7 +284,7 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<Ra
     let diffuse: Vec<Ray> = surface
         .iter()
         .map(|(p, ng, sampler)| {
-            let mut sampler = sampler.clone();
+            let mut sampler = *sampler;
             let wi = from_local(&frame_from_normal(*ng), sample_cosine_hemisphere(sample_2d(&mut sampler)));
             Ray { origin: offset_ray(*p, *ng), dir: wi }
         })

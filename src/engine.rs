@@ -43,6 +43,8 @@ pub(crate) trait Engine: Send {
     fn gpu(&self) -> Option<&gpu::GpuRenderer> {
         None
     }
+    /// Chooses how the CPU engine runs the integrator (no effect on the GPU's).
+    fn set_cpu_kernel(&mut self, _kernel: cpu::Kernel) {}
 }
 
 impl Engine for cpu::Renderer {
@@ -51,7 +53,10 @@ impl Engine for cpu::Renderer {
     }
 
     fn adapter_name(&self) -> String {
-        format!("cpu ({} threads)", rayon::current_num_threads())
+        match self.kernel() {
+            cpu::Kernel::Lanes => format!("cpu ({} threads)", rayon::current_num_threads()),
+            k => format!("cpu ({} threads, {} kernel)", rayon::current_num_threads(), k.name()),
+        }
     }
 
     fn scene(&self) -> &PackedScene {
@@ -94,6 +99,10 @@ impl Engine for cpu::Renderer {
 
     fn set_film(&mut self, film: &Film) {
         cpu::Renderer::set_film(self, film);
+    }
+
+    fn set_cpu_kernel(&mut self, kernel: cpu::Kernel) {
+        cpu::Renderer::set_kernel(self, kernel);
     }
 }
 

@@ -100,6 +100,13 @@ impl Renderer {
         self.engine.backend()
     }
 
+    /// How the CPU engine runs the integrator: `cpu::Kernel::Lanes` (the default, fast) or
+    /// `Reference` (one path at a time, the GPU kernel's twin); the films are the same bits.
+    /// No effect on the GPU engine.
+    pub fn set_cpu_kernel(&mut self, kernel: cpu::Kernel) {
+        self.engine.set_cpu_kernel(kernel);
+    }
+
     /// The engine and its device, for logs and statistics.
     pub fn adapter_name(&self) -> String {
         self.engine.adapter_name()

@@ -294,10 +294,15 @@ pub fn specular_transmission_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32, alp
 }
 
 pub fn base_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+    base_pdf_chosen(m, lobe_probabilities(m, wo.z, eta), wo, wi, eta)
+}
+
+/// `base_pdf` with the lobe probabilities `p` from wo already known.
+#[inline]
+pub fn base_pdf_chosen(m: &Material, p: Vec4, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
     if wo.z <= 0.0 || wi.z == 0.0 {
         return 0.0;
     }
-    let p = lobe_probabilities(m, wo.z, eta);
     let alpha = m.roughness * m.roughness;
     if wi.z < 0.0 {
         let mut pdf = p.w * cosine_hemisphere_pdf(-wi.z);
@@ -314,11 +319,16 @@ pub fn base_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
 }
 
 pub fn base_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
+    base_sample_chosen(m, lobe_probabilities(m, wo.z, eta), wo, u, eta)
+}
+
+/// `base_sample` with the lobe probabilities `p` from wo already known.
+#[inline]
+pub fn base_sample_chosen(m: &Material, p: Vec4, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
     let none = BsdfSample { wi: Vec3::Z, weight: Vec3::ZERO, pdf: 0.0, delta: false };
     if wo.z <= 0.0 {
         return none;
     }
-    let p = lobe_probabilities(m, wo.z, eta);
     let alpha = m.roughness * m.roughness;
     let wi = if u.x < p.x {
         if !specular_is_rough(m, alpha) {
@@ -369,7 +379,7 @@ pub fn base_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
             wi
         }
     };
-    let pdf = base_pdf(m, wo, wi, eta);
+    let pdf = base_pdf_chosen(m, p, wo, wi, eta);
     if wi.z == 0.0 || pdf <= 0.0 {
         return none;
     }
@@ -427,15 +437,35 @@ pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
     f
 }
 
+/// The lobe probabilities of a material seen from wo: the base's lobes and, under a coat or a
+/// sheen, the layers'. They depend on wo alone, so a path's vertex computes them once for its
+/// light sample's MIS weight and its BSDF sample (`*_chosen`).
+#[derive(Clone, Copy, Debug)]
+pub struct LobeChoice {
+    pub base: Vec4,
+    pub layers: Vec3,
+}
+
+pub fn lobe_choice(m: &Material, wo: Vec3, eta: f32) -> LobeChoice {
+    let layers = if has_layers(m) { layer_probabilities(m, wo, eta) } else { Vec3::ZERO };
+    LobeChoice { base: lobe_probabilities(m, wo.z, eta), layers }
+}
+
 pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+    bsdf_pdf_chosen(m, &lobe_choice(m, wo, eta), wo, wi, eta)
+}
+
+/// `bsdf_pdf` with the lobe choice from wo already known.
+#[inline]
+pub fn bsdf_pdf_chosen(m: &Material, c: &LobeChoice, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
     if !has_layers(m) {
-        return base_pdf(m, wo, wi, eta);
+        return base_pdf_chosen(m, c.base, wo, wi, eta);
     }
     if wo.z <= 0.0 || wi.z == 0.0 {
         return 0.0;
     }
-    let p = layer_probabilities(m, wo, eta);
-    let mut pdf = p.z * base_pdf(m, wo, wi, eta);
+    let p = c.layers;
+    let mut pdf = p.z * base_pdf_chosen(m, c.base, wo, wi, eta);
     if wi.z > 0.0 {
         pdf += p.x * coat_pdf(m, wo, wi) + p.y * UNIFORM_HEMISPHERE_PDF;
     }
@@ -445,16 +475,22 @@ pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
 /// Picks the base, the coat or the sheen with u.x, then a direction from it (the base with
 /// u.x rescaled to its share). Dirac lobes of the base keep its layers' scaling.
 pub fn bsdf_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
+    bsdf_sample_chosen(m, &lobe_choice(m, wo, eta), wo, u, eta)
+}
+
+/// `bsdf_sample` with the lobe choice from wo already known.
+#[inline]
+pub fn bsdf_sample_chosen(m: &Material, c: &LobeChoice, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
     if !has_layers(m) {
-        return base_sample(m, wo, u, eta);
+        return base_sample_chosen(m, c.base, wo, u, eta);
     }
     let none = BsdfSample { wi: Vec3::Z, weight: Vec3::ZERO, pdf: 0.0, delta: false };
     if wo.z <= 0.0 {
         return none;
     }
-    let p = layer_probabilities(m, wo, eta);
+    let p = c.layers;
     let wi = if u.x < p.z {
-        let s = base_sample(m, wo, Vec3::new(u.x / p.z, u.y, u.z), eta);
+        let s = base_sample_chosen(m, c.base, wo, Vec3::new(u.x / p.z, u.y, u.z), eta);
         if s.pdf <= 0.0 {
             return none;
         }
@@ -478,7 +514,7 @@ pub fn bsdf_sample(m: &Material, wo: Vec3, u: Vec3, eta: f32) -> BsdfSample {
         }
         sample_uniform_hemisphere(Vec2::new(u.y, u.z))
     };
-    let pdf = bsdf_pdf(m, wo, wi, eta);
+    let pdf = bsdf_pdf_chosen(m, c, wo, wi, eta);
     if wi.z == 0.0 || pdf <= 0.0 {
         return none;
     }

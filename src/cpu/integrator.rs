@@ -1,6 +1,8 @@
 //! Twin of `shaders/integrator.wgsl`: the path tracer, sample for sample.
 
-use super::bsdf::{bsdf_albedo, bsdf_eval, bsdf_is_delta, bsdf_pdf, bsdf_sample};
+use super::bsdf::{
+    BsdfSample, LobeChoice, bsdf_albedo, bsdf_eval, bsdf_is_delta, bsdf_pdf_chosen, bsdf_sample_chosen, lobe_choice,
+};
 use super::bvh::{Hit, NO_HIT, intersect_closest, occluded, offset_ray};
 use super::camera::camera_sample;
 use super::common::{INF, Ray};
@@ -18,7 +20,8 @@ use crate::Strategy;
 use crate::aov::AovSample;
 use crate::packed::{MAT_THIN_WALLED, Material, NO_TEXTURE, PackedScene, TRI_MIRRORED};
 use crate::params::{LIGHT_SAMPLER_TREE, Params};
-use glam::{UVec2, Vec3};
+use glam::{UVec2, Vec3, Vec4};
+use std::borrow::Cow;
 
 /// A path's colour channel before it meets a dispersive surface: all three.
 pub const ALL_CHANNELS: u32 = 3;
@@ -33,7 +36,7 @@ fn spawn_point(point: Vec3, ng: Vec3, wi: Vec3) -> Vec3 {
 
 /// Twin of `connect` in the shader: f · |cos θ| · L, or 0 (blocked, zero BSDF, no density).
 #[allow(clippy::too_many_arguments)]
-fn connect(
+pub fn connect(
     scene: &PackedScene,
     m: &Material,
     frame: &Frame,
@@ -48,6 +51,20 @@ fn connect(
     }
     let wi_local = to_local(frame, ls.wi);
     let f = bsdf_eval(m, wo, wi_local, eta);
+    connect_evaluated(scene, point, ng, ls, wi_local, f)
+}
+
+/// `connect` once the BSDF's value `f` for the light sample (`wi_local` in the shading
+/// frame, `ls.pdf` > 0) is known: the side test, then the shadow ray.
+#[inline(always)]
+pub fn connect_evaluated(
+    scene: &PackedScene,
+    point: Vec3,
+    ng: Vec3,
+    ls: &LightSample,
+    wi_local: Vec3,
+    f: Vec3,
+) -> Vec3 {
     if !same_side(ls.wi, ng, wi_local)
         || f.max_element() <= 0.0
         || !unoccluded(scene, spawn_point(point, ng, ls.wi), ls)
@@ -79,7 +96,7 @@ pub fn clamp_contribution(params: &Params, c: Vec3, segments: u32) -> Vec3 {
 /// next. The stages below (`path_escaped`, `path_surface`, `path_next_event`, `path_scatter`)
 /// each advance it by one step of `li`, so a scalar loop over them is the reference integrator
 /// and an engine running paths in lanes can run each stage over many paths.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 pub struct PathState {
     pub ray: Ray,
     pub radiance: Vec3,
@@ -121,11 +138,12 @@ impl PathState {
 }
 
 /// The surface at a path's vertex, as `path_surface` prepares it for light and BSDF sampling.
-#[derive(Clone, Copy, Debug)]
-pub struct SurfaceVertex {
+#[derive(Clone, Debug)]
+pub struct SurfaceVertex<'a> {
     /// The material at the point (textures applied, the path's dispersion ior, the coat
-    /// normal and anisotropy direction in the local frame).
-    pub mat: Material,
+    /// normal and anisotropy direction in the local frame): borrowed from the scene when
+    /// none of these changes it, the common case, else a copy (~740 bytes).
+    pub mat: Cow<'a, Material>,
     pub point: Vec3,
     /// Geometric normal on the side the ray arrived from.
     pub ng: Vec3,
@@ -134,6 +152,8 @@ pub struct SurfaceVertex {
     pub frame: Frame,
     pub wo: Vec3,
     pub ctx: LightContext,
+    /// The BSDF's lobe probabilities from `wo`, for both of the vertex's samples.
+    pub lobes: LobeChoice,
 }
 
 /// The strategy of the direct-lighting estimator (`params.strategy`).
@@ -162,15 +182,28 @@ pub fn path_escaped(scene: &PackedScene, params: &Params, path: &mut PathState) 
 /// against the previous vertex's light sample), the dispersion channel, the shading frame and
 /// the AOVs. None when the path ends here (its last segment).
 #[inline(always)]
-pub fn path_surface(scene: &PackedScene, params: &Params, path: &mut PathState, hit: &Hit) -> Option<SurfaceVertex> {
+pub fn path_surface<'a>(
+    scene: &'a PackedScene,
+    params: &Params,
+    path: &mut PathState,
+    hit: &Hit,
+) -> Option<SurfaceVertex<'a>> {
     let strategy = path_strategy(params);
     let ray = path.ray;
     let depth = path.depth;
     let tri = &world_triangle(scene, hit.tri, hit.instance);
-    let uv = triangle_uv(scene, hit.tri, hit.u, hit.v);
+    let stored = &scene.materials[tri.material as usize];
+    // UVs only matter to textures; without textures or vertex colours the material at the
+    // point is the stored one (what material_at would copy).
+    let textured = scene.material_textured[tri.material as usize];
+    let uv = if textured { triangle_uv(scene, hit.tri, hit.u, hit.v) } else { Vec4::ZERO };
     let color = vertex_color(scene, hit.tri, hit.u, hit.v);
-    let mut mat = material_at(scene, &scene.materials[tri.material as usize], uv, color);
-    let m = &mat;
+    let mut mat = if textured || color != Vec4::ONE {
+        Cow::Owned(material_at(scene, stored, uv, color))
+    } else {
+        Cow::Borrowed(stored)
+    };
+    let m = &*mat;
     let (e1, e2) = (Vec3::from(tri.e1), Vec3::from(tri.e2));
     let point = Vec3::from(tri.p0) + hit.u * e1 + hit.v * e2;
     let ng_cross = e1.cross(e2).normalize();
@@ -214,9 +247,10 @@ pub fn path_surface(scene: &PackedScene, params: &Params, path: &mut PathState, 
             mask[path.channel as usize] = 3.0;
             path.beta *= mask;
         }
-        mat.ior = dispersed_ior(mat.ior, mat.dispersion, path.channel);
+        let ior = dispersed_ior(mat.ior, mat.dispersion, path.channel);
+        mat.to_mut().ior = ior;
     }
-    let m = &mat;
+    let m = &*mat;
     let ng = if cos_hit > 0.0 { -ng_raw } else { ng_raw };
     // A thin wall has air on both sides.
     let eta = if cos_hit < 0.0 || m.flags & MAT_THIN_WALLED != 0 { m.ior } else { 1.0 / m.ior };
@@ -234,19 +268,19 @@ pub fn path_surface(scene: &PackedScene, params: &Params, path: &mut PathState, 
         if nc.dot(ray.dir) > 0.0 {
             nc = -nc;
         }
-        mat.coat_normal = to_local(&frame, nc).into();
+        mat.to_mut().coat_normal = to_local(&frame, nc).into();
     }
     // Anisotropy turns with the tangent frame; without tangents the lobe stays isotropic.
     if mat.anisotropy > 0.0 {
         let d = to_local(&frame, anisotropy_direction(scene, tri, hit.tri, hit.instance, hit.u, hit.v, ns, &mat, uv));
         let len = (d.x * d.x + d.y * d.y).sqrt();
         if len > 1e-6 {
-            mat.anisotropy_tangent = [d.x / len, d.y / len];
+            mat.to_mut().anisotropy_tangent = [d.x / len, d.y / len];
         } else {
-            mat.anisotropy = 0.0;
+            mat.to_mut().anisotropy = 0.0;
         }
     }
-    let m = &mat;
+    let m = &*mat;
     if path.aov_open {
         if depth == 1 {
             path.aov.depth = hit.t;
@@ -259,7 +293,8 @@ pub fn path_surface(scene: &PackedScene, params: &Params, path: &mut PathState, 
         return None;
     }
     let ctx = LightContext { point, normal: ns, reflect_only: m.transmission <= 0.0 && m.diffuse_transmission <= 0.0 };
-    Some(SurfaceVertex { mat, point, ng, eta, frame, wo, ctx })
+    let lobes = lobe_choice(m, wo, eta);
+    Some(SurfaceVertex { mat, point, ng, eta, frame, wo, ctx, lobes })
 }
 
 /// Whether next-event estimation runs at a vertex. With the BSDF strategy alone it still runs
@@ -305,26 +340,49 @@ pub fn path_connect_light(
     ls: &LightSample,
 ) {
     if ls.delta || strategy != Strategy::Bsdf {
-        let m = &sv.mat;
+        let m = &*sv.mat;
         let c = connect(scene, m, &sv.frame, sv.wo, sv.eta, sv.point, sv.ng, ls);
-        if c.max_element() > 0.0 {
-            let w = if strategy == Strategy::Light || ls.delta {
-                1.0
-            } else {
-                mis_weight(strategy, ls.pdf, bsdf_pdf(m, sv.wo, to_local(&sv.frame, ls.wi), sv.eta))
-            };
-            path.radiance += clamp_contribution(params, path.beta * c * (w / ls.pdf), path.depth + 1);
-        }
+        path_add_light(params, strategy, path, ls, c, || {
+            bsdf_pdf_chosen(m, &sv.lobes, sv.wo, to_local(&sv.frame, ls.wi), sv.eta)
+        });
+    }
+}
+
+/// Adds a connected light sample's contribution `c`, weighted by MIS against the BSDF's
+/// density for its direction (`bsdf_pdf`, asked only when the weight needs it).
+#[inline(always)]
+pub fn path_add_light(
+    params: &Params,
+    strategy: Strategy,
+    path: &mut PathState,
+    ls: &LightSample,
+    c: Vec3,
+    bsdf_pdf: impl FnOnce() -> f32,
+) {
+    if c.max_element() > 0.0 {
+        let w = if strategy == Strategy::Light || ls.delta { 1.0 } else { mis_weight(strategy, ls.pdf, bsdf_pdf()) };
+        path.radiance += clamp_contribution(params, path.beta * c * (w / ls.pdf), path.depth + 1);
     }
 }
 
 /// The BSDF sample that continues the path, then Russian roulette. False when the path ends.
 #[inline(always)]
 pub fn path_scatter(params: &Params, path: &mut PathState, sv: &SurfaceVertex) -> bool {
-    let m = &sv.mat;
+    let bs = bsdf_sample_chosen(&sv.mat, &sv.lobes, sv.wo, path_scatter_u(path), sv.eta);
+    path_continue(params, path, sv, &bs)
+}
+
+/// The numbers of the vertex's BSDF sample.
+#[inline(always)]
+pub fn path_scatter_u(path: &mut PathState) -> Vec3 {
     let u0 = sample_1d(&mut path.sampler);
     let u12 = sample_2d(&mut path.sampler);
-    let bs = bsdf_sample(m, sv.wo, Vec3::new(u0, u12.x, u12.y), sv.eta);
+    Vec3::new(u0, u12.x, u12.y)
+}
+
+/// The path continues along the BSDF sample `bs`, then Russian roulette. False when it ends.
+#[inline(always)]
+pub fn path_continue(params: &Params, path: &mut PathState, sv: &SurfaceVertex, bs: &BsdfSample) -> bool {
     if bs.pdf <= 0.0 {
         return false;
     }
@@ -374,7 +432,7 @@ pub fn trace_path(scene: &PackedScene, params: &Params, path: &mut PathState) {
 /// Radiance arriving along a camera ray; with AOVs on (`params.aov_base`), what the ray saw of
 /// the first visible surface goes into `aov` (`src/aov.rs`).
 pub fn li(scene: &PackedScene, params: &Params, camera_ray: Ray, sampler: &mut Sampler, aov: &mut AovSample) -> Vec3 {
-    let mut path = PathState::new(params, camera_ray, sampler.clone());
+    let mut path = PathState::new(params, camera_ray, *sampler);
     trace_path(scene, params, &mut path);
     *sampler = path.sampler;
     *aov = path.aov;

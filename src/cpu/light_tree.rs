@@ -8,7 +8,7 @@ use glam::{BVec4A, Vec2, Vec3, Vec4};
 /// What light selection knows of the shading point. A BSDF hit on an emitter recomputes the
 /// selection probability with the context of the vertex the ray left, bit for bit the one
 /// next-event estimation used there.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct LightContext {
     pub point: Vec3,
     /// Shading normal facing the outgoing direction.
@@ -201,7 +201,12 @@ fn group_importance(ctx: &LightContext, g: &LightGroup) -> (Vec4, Vec4) {
 /// plane test of one-sided leaf triangles; `child_share` against their sum), or None at a
 /// dead end (no child can contribute). Both walks step through this.
 #[inline(always)]
-fn group_shares(scene: &PackedScene, params: &Params, ctx: &LightContext, g: &LightGroup) -> Option<[f32; 4]> {
+pub(crate) fn group_shares(
+    scene: &PackedScene,
+    params: &Params,
+    ctx: &LightContext,
+    g: &LightGroup,
+) -> Option<[f32; 4]> {
     let (far, near) = group_importance(ctx, g);
     let (mut far, mut near) = (far.to_array(), near.to_array());
     for lane in 0..4 {

@@ -31,6 +31,33 @@ pub struct LightSample {
 /// `env_select`, else an emitter (by power, or by the light tree from `ctx`), then a point
 /// on it. `pdf` is the solid-angle density (the selection probability for Dirac lights).
 pub fn sample_light(scene: &PackedScene, params: &Params, ctx: &LightContext, u: Vec3) -> LightSample {
+    let walk = match tree_u(params, u.x) {
+        Some(u_tree) => sample_light_tree(scene, params, ctx, u_tree),
+        None => (0, 0.0),
+    };
+    sample_light_chosen(scene, params, ctx, u, walk)
+}
+
+/// The number the light tree's walk takes when light sampling draws `u_x` (None: the
+/// environment or the power sampler chooses, not the tree).
+#[inline(always)]
+pub fn tree_u(params: &Params, u_x: f32) -> Option<f32> {
+    let env_select = params.env_select;
+    if u_x < env_select || params.light_sampler != LIGHT_SAMPLER_TREE {
+        return None;
+    }
+    Some(((u_x - env_select) / (1.0 - env_select)).min(ONE_MINUS_EPSILON))
+}
+
+/// `sample_light` once the tree's walk (emitter, probability) for `tree_u(u.x)` is known
+/// (unused when that is None): the walks of many paths can run side by side first.
+pub fn sample_light_chosen(
+    scene: &PackedScene,
+    params: &Params,
+    ctx: &LightContext,
+    u: Vec3,
+    walk: (u32, f32),
+) -> LightSample {
     let ref_point = ctx.point;
     let env_select = params.env_select;
     if u.x < env_select {
@@ -47,7 +74,7 @@ pub fn sample_light(scene: &PackedScene, params: &Params, ctx: &LightContext, u:
     }
     let u_select = (u.x - env_select) / (1.0 - env_select);
     let (triangle, select_pmf) = if params.light_sampler == LIGHT_SAMPLER_TREE {
-        let (emitter, pmf) = sample_light_tree(scene, params, ctx, u_select.min(ONE_MINUS_EPSILON));
+        let (emitter, pmf) = walk;
         let pmf = (1.0 - env_select) * pmf;
         if pmf <= 0.0 {
             return LightSample {

@@ -13,6 +13,7 @@ pub mod frame;
 pub mod instance;
 pub mod integrator;
 pub mod iridescence;
+pub mod lanes;
 pub mod light_tree;
 pub mod lights;
 pub mod material;
@@ -26,4 +27,4 @@ pub mod spherical_triangle;
 pub mod texture;
 
 pub use integrator::render_sample;
-pub use renderer::Renderer;
+pub use renderer::{Kernel, Renderer};

@@ -1,6 +1,7 @@
 //! The CPU engine: the integrator of this folder over the film's pixels with rayon, the twin
 //! of `gpu::GpuRenderer`.
 
+use super::lanes::{LANES, lanes_of, render_packet};
 use crate::adaptive::{adaptive_add_sample, adaptive_settle, adaptive_test_due};
 use crate::aov::aov_add_sample;
 use crate::film::{ADAPTIVE_WORDS, AOV_WORDS, Film, WORDS_PER_PIXEL, film_add_sample};
@@ -14,6 +15,34 @@ pub struct Renderer {
     film: Film,
     /// Samples taken by the pixels still sampling (adaptive sampling's test schedule).
     taken: u32,
+    kernel: Kernel,
+}
+
+/// How the CPU engine runs the integrator: the same films either way, bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernel {
+    /// One path at a time through `li`: the reference the GPU kernel is held to.
+    Reference,
+    /// Packets of paths through the same stages (`cpu::lanes`): the fast path.
+    Lanes,
+}
+
+impl Kernel {
+    /// `Lanes`, unless the environment variable VEACH_CPU_KERNEL says `reference` (for
+    /// benchmarks of the two in one build).
+    pub fn from_env() -> Kernel {
+        match std::env::var("VEACH_CPU_KERNEL").as_deref() {
+            Ok("reference") => Kernel::Reference,
+            _ => Kernel::Lanes,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Kernel::Reference => "reference",
+            Kernel::Lanes => "lanes",
+        }
+    }
 }
 
 fn empty_film(params: &Params) -> Film {
@@ -29,7 +58,10 @@ struct Row<'a> {
 }
 
 /// Samples `samples` of film row `y` (converged pixels are skipped).
-fn render_row(scene: &PackedScene, base: &Params, samples: std::ops::Range<u32>, y: usize, row: Row) {
+fn render_row(kernel: Kernel, scene: &PackedScene, base: &Params, samples: std::ops::Range<u32>, y: usize, row: Row) {
+    if kernel == Kernel::Lanes {
+        return render_row_lanes(scene, base, samples, y, row);
+    }
     let Row { words, mut adaptive, mut aovs } = row;
     for s in samples {
         let p = Params { sample_index: s, ..*base };
@@ -49,10 +81,57 @@ fn render_row(scene: &PackedScene, base: &Params, samples: std::ops::Range<u32>,
     }
 }
 
+/// `render_row` with packets of `LANES` neighbouring pixels: each pixel still gets its
+/// samples in order, so its sums are the same bits.
+fn render_row_lanes(scene: &PackedScene, base: &Params, samples: std::ops::Range<u32>, y: usize, row: Row) {
+    let Row { words, mut adaptive, mut aovs } = row;
+    let width = words.len() / WORDS_PER_PIXEL;
+    for s in samples {
+        let p = Params { sample_index: s, ..*base };
+        for x0 in (0..width).step_by(LANES) {
+            let n = (width - x0).min(LANES);
+            let mut mask = 0u32;
+            for i in 0..n {
+                if adaptive.as_ref().is_none_or(|(_, flags)| flags[x0 + i] == 0) {
+                    mask |= 1 << i;
+                }
+            }
+            if mask == 0 {
+                continue;
+            }
+            let results = render_packet(scene, &p, x0 as u32, y as u32, mask);
+            for i in lanes_of(mask) {
+                let x = x0 + i;
+                let (l, aov) = &results[i];
+                let pixel = &mut words[x * WORDS_PER_PIXEL..(x + 1) * WORDS_PER_PIXEL];
+                film_add_sample(pixel, *l);
+                if let Some((records, _)) = &mut adaptive {
+                    adaptive_add_sample(&p, pixel, &mut records[x * ADAPTIVE_WORDS..(x + 1) * ADAPTIVE_WORDS], *l);
+                }
+                if let Some(records) = &mut aovs {
+                    aov_add_sample(&mut records[x * AOV_WORDS..(x + 1) * AOV_WORDS], aov);
+                }
+            }
+        }
+    }
+}
+
 impl Renderer {
     pub fn new(scene: PackedScene, params: Params) -> Renderer {
+        Renderer::with_kernel(scene, params, Kernel::from_env())
+    }
+
+    pub fn with_kernel(scene: PackedScene, params: Params, kernel: Kernel) -> Renderer {
         let film = empty_film(&params);
-        Renderer { scene, params, film, taken: 0 }
+        Renderer { scene, params, film, taken: 0, kernel }
+    }
+
+    pub fn kernel(&self) -> Kernel {
+        self.kernel
+    }
+
+    pub fn set_kernel(&mut self, kernel: Kernel) {
+        self.kernel = kernel;
     }
 
     pub fn scene(&self) -> &PackedScene {
@@ -84,7 +163,7 @@ impl Renderer {
 
     /// Samples `start .. start + count` of film rows `rows`, rows in parallel.
     fn render_range(&mut self, start: u32, count: u32, rows: std::ops::Range<usize>) {
-        let (scene, base) = (&self.scene, self.params);
+        let (scene, base, kernel) = (&self.scene, self.params, self.kernel);
         let width = base.film_width as usize;
         let pixels = self.film.pixel_count();
         let layout = self.film.layout;
@@ -112,7 +191,7 @@ impl Renderer {
             .enumerate()
             .skip(rows.start)
             .take(rows.len())
-            .for_each(|(y, row)| render_row(scene, &base, start..start + count, y, row));
+            .for_each(|(y, row)| render_row(kernel, scene, &base, start..start + count, y, row));
     }
 
     /// Accumulates sample `sample` for film rows `y0 .. y0 + rows`; the last band of a sample

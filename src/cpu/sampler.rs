@@ -7,7 +7,7 @@ use glam::Vec2;
 pub const SAMPLER_INDEPENDENT: u32 = crate::SamplerKind::Independent as u32;
 pub const SAMPLER_SOBOL: u32 = crate::SamplerKind::Sobol as u32;
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 pub struct Sampler {
     kind: u32,
     pixel_seed: u32,

@@ -36,6 +36,31 @@ use glam::Vec3;
 use instances::build_instances;
 use light_tree::{pack_light_tree, punctual_bounds, triangle_bounds};
 
+/// Does the material read any texture?
+fn has_texture(m: &Material) -> bool {
+    [
+        &m.base_color_texture,
+        &m.metallic_roughness_texture,
+        &m.emissive_texture,
+        &m.normal_texture,
+        &m.transmission_texture,
+        &m.specular_texture,
+        &m.specular_color_texture,
+        &m.clearcoat_texture,
+        &m.clearcoat_roughness_texture,
+        &m.clearcoat_normal_texture,
+        &m.sheen_color_texture,
+        &m.sheen_roughness_texture,
+        &m.anisotropy_texture,
+        &m.iridescence_texture,
+        &m.iridescence_thickness_texture,
+        &m.diffuse_transmission_texture,
+        &m.diffuse_transmission_color_texture,
+    ]
+    .iter()
+    .any(|t| t.atlas != NO_TEXTURE)
+}
+
 /// (nodes, depth, build seconds, bytes) of the packed light tree over `emitters`: `veach
 /// bench`'s scale test.
 pub fn pack_light_tree_for_bench(emitters: &[crate::accel::light_bvh::LightBounds]) -> (usize, u32, f64, usize) {
@@ -63,6 +88,8 @@ pub struct PackedScene {
     /// `attributes`, one a triangle in the same order (`geometry::pack_extras`); 0: none.
     pub extras_base: u32,
     pub materials: Vec<Material>,
+    /// Per material: has it a texture (CPU only: a hit on one without needs no UVs).
+    pub material_textured: Vec<bool>,
     pub lights: Vec<LightEntry>,
     /// The `lights` buffer: the alias table (one row per entry, `LightEntry` as u32 bits),
     /// then from `tree_base` the light tree's node records (`LIGHT_NODE_ROWS` rows each: the
@@ -257,6 +284,7 @@ impl PackedScene {
             triangle_lanes: std::sync::OnceLock::new(),
             attributes,
             extras_base,
+            material_textured: materials.iter().map(has_texture).collect(),
             materials,
             lights,
             light_rows,

@@ -6,6 +6,7 @@ pub mod chi2;
 pub mod cli;
 pub mod probe;
 pub mod rng;
+pub mod scenes;
 
 use glam::Vec3;
 use std::path::{Path, PathBuf};

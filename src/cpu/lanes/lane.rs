@@ -1,0 +1,364 @@
+//! Lanes of numbers for the packet's arithmetic: `F8` (f32), `U8` (u32), `M8` (a mask) and
+//! `V3` (three `F8`, a vector per lane). Every operation is the scalar one, lane by lane, in
+//! the same order — no fused multiply-add; `max_num`/`min_num`/`clamp` with Rust's scalar
+//! semantics; `dot`, `cross` and `normalize` as glam's `Vec3` computes them — so each lane
+//! holds the bits the scalar reference computes. They are loops over fixed arrays, which LLVM
+//! turns into single AVX2 instructions inside functions compiled for AVX2 (`super::wide`) and
+//! into SSE or NEON pairs elsewhere.
+
+use glam::Vec3;
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+/// Lanes of a packet.
+pub const W: usize = super::LANES;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub struct F8(pub [f32; W]);
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C, align(32))]
+pub struct U8(pub [u32; W]);
+
+/// A mask: a lane is true when all its bits are set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C, align(32))]
+pub struct M8(pub [u32; W]);
+
+#[inline(always)]
+fn lanes<T>(f: impl FnMut(usize) -> T) -> [T; W] {
+    std::array::from_fn(f)
+}
+
+impl F8 {
+    #[inline(always)]
+    pub fn splat(x: f32) -> F8 {
+        F8([x; W])
+    }
+
+    /// Lane `i` is `f(i)`.
+    #[inline(always)]
+    pub fn from_fn(f: impl FnMut(usize) -> f32) -> F8 {
+        F8(lanes(f))
+    }
+
+    #[inline(always)]
+    pub fn map(self, f: impl Fn(f32) -> f32) -> F8 {
+        F8(lanes(|i| f(self.0[i])))
+    }
+
+    #[inline(always)]
+    pub fn zip(self, o: F8, f: impl Fn(f32, f32) -> f32) -> F8 {
+        F8(lanes(|i| f(self.0[i], o.0[i])))
+    }
+
+    #[inline(always)]
+    fn compare(self, o: F8, f: impl Fn(f32, f32) -> bool) -> M8 {
+        M8(lanes(|i| if f(self.0[i], o.0[i]) { u32::MAX } else { 0 }))
+    }
+
+    #[inline(always)]
+    pub fn sqrt(self) -> F8 {
+        self.map(f32::sqrt)
+    }
+
+    #[inline(always)]
+    pub fn abs(self) -> F8 {
+        self.map(f32::abs)
+    }
+
+    /// `f32::max`: the other operand when one is NaN.
+    #[inline(always)]
+    pub fn max_num(self, o: F8) -> F8 {
+        self.zip(o, f32::max)
+    }
+
+    /// `f32::min`.
+    #[inline(always)]
+    pub fn min_num(self, o: F8) -> F8 {
+        self.zip(o, f32::min)
+    }
+
+    /// `f32::clamp`: NaN stays NaN.
+    #[inline(always)]
+    pub fn clamp(self, lo: f32, hi: f32) -> F8 {
+        self.map(|x| {
+            let mut x = x;
+            if x < lo {
+                x = lo;
+            }
+            if x > hi {
+                x = hi;
+            }
+            x
+        })
+    }
+
+    #[inline(always)]
+    pub fn lt(self, o: F8) -> M8 {
+        self.compare(o, |a, b| a < b)
+    }
+
+    #[inline(always)]
+    pub fn le(self, o: F8) -> M8 {
+        self.compare(o, |a, b| a <= b)
+    }
+
+    #[inline(always)]
+    pub fn gt(self, o: F8) -> M8 {
+        self.compare(o, |a, b| a > b)
+    }
+
+    #[inline(always)]
+    pub fn ge(self, o: F8) -> M8 {
+        self.compare(o, |a, b| a >= b)
+    }
+
+    #[inline(always)]
+    pub fn eq(self, o: F8) -> M8 {
+        self.compare(o, |a, b| a == b)
+    }
+
+    /// `a` where `m`, else `b`.
+    #[inline(always)]
+    pub fn select(m: M8, a: F8, b: F8) -> F8 {
+        F8(lanes(|i| if m.0[i] != 0 { a.0[i] } else { b.0[i] }))
+    }
+}
+
+macro_rules! float_op {
+    ($trait:ident, $f:ident, $op:tt) => {
+        impl $trait for F8 {
+            type Output = F8;
+            #[inline(always)]
+            fn $f(self, o: F8) -> F8 {
+                F8(lanes(|i| self.0[i] $op o.0[i]))
+            }
+        }
+        impl $trait<f32> for F8 {
+            type Output = F8;
+            #[inline(always)]
+            fn $f(self, o: f32) -> F8 {
+                F8(lanes(|i| self.0[i] $op o))
+            }
+        }
+        impl $trait<F8> for f32 {
+            type Output = F8;
+            #[inline(always)]
+            fn $f(self, o: F8) -> F8 {
+                F8(lanes(|i| self $op o.0[i]))
+            }
+        }
+    };
+}
+float_op!(Add, add, +);
+float_op!(Sub, sub, -);
+float_op!(Mul, mul, *);
+float_op!(Div, div, /);
+
+impl Neg for F8 {
+    type Output = F8;
+    #[inline(always)]
+    fn neg(self) -> F8 {
+        self.map(|x| -x)
+    }
+}
+
+impl M8 {
+    #[inline(always)]
+    pub fn splat(b: bool) -> M8 {
+        M8([if b { u32::MAX } else { 0 }; W])
+    }
+
+    /// Lane i set where bit i of `bits` is.
+    #[inline(always)]
+    pub fn from_bits(bits: u32) -> M8 {
+        M8(lanes(|i| if bits >> i & 1 != 0 { u32::MAX } else { 0 }))
+    }
+
+    /// Bit i set where lane i is.
+    #[inline(always)]
+    pub fn bits(self) -> u32 {
+        let mut b = 0;
+        for i in 0..W {
+            b |= (self.0[i] & 1) << i;
+        }
+        b
+    }
+
+    #[inline(always)]
+    pub fn lane(self, i: usize) -> bool {
+        self.0[i] != 0
+    }
+}
+
+impl BitAnd for M8 {
+    type Output = M8;
+    #[inline(always)]
+    fn bitand(self, o: M8) -> M8 {
+        M8(lanes(|i| self.0[i] & o.0[i]))
+    }
+}
+
+impl BitOr for M8 {
+    type Output = M8;
+    #[inline(always)]
+    fn bitor(self, o: M8) -> M8 {
+        M8(lanes(|i| self.0[i] | o.0[i]))
+    }
+}
+
+impl Not for M8 {
+    type Output = M8;
+    #[inline(always)]
+    fn not(self) -> M8 {
+        M8(lanes(|i| !self.0[i]))
+    }
+}
+
+impl U8 {
+    #[inline(always)]
+    pub fn splat(x: u32) -> U8 {
+        U8([x; W])
+    }
+
+    #[inline(always)]
+    pub fn from_fn(f: impl FnMut(usize) -> u32) -> U8 {
+        U8(lanes(f))
+    }
+
+    #[inline(always)]
+    pub fn map(self, f: impl Fn(u32) -> u32) -> U8 {
+        U8(lanes(|i| f(self.0[i])))
+    }
+
+    #[inline(always)]
+    pub fn zip(self, o: U8, f: impl Fn(u32, u32) -> u32) -> U8 {
+        U8(lanes(|i| f(self.0[i], o.0[i])))
+    }
+
+    /// (x >> 8) / 2²⁴: a float in [0, 1) from the top 24 bits (`unit_float`), converted as a
+    /// signed integer (exact below 2²⁴, one instruction on x86).
+    #[inline(always)]
+    pub fn unit_float(self) -> F8 {
+        F8(lanes(|i| (self.0[i] >> 8) as i32 as f32 * (1.0 / 16777216.0)))
+    }
+}
+
+/// Three lanes of floats: a vector per lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct V3 {
+    pub x: F8,
+    pub y: F8,
+    pub z: F8,
+}
+
+impl V3 {
+    #[inline(always)]
+    pub fn new(x: F8, y: F8, z: F8) -> V3 {
+        V3 { x, y, z }
+    }
+
+    #[inline(always)]
+    pub fn splat(v: Vec3) -> V3 {
+        V3::new(F8::splat(v.x), F8::splat(v.y), F8::splat(v.z))
+    }
+
+    /// Lane `i` is `f(i)`.
+    #[inline(always)]
+    pub fn from_fn(f: impl Fn(usize) -> Vec3) -> V3 {
+        let v: [Vec3; W] = lanes(f);
+        V3::new(F8(lanes(|i| v[i].x)), F8(lanes(|i| v[i].y)), F8(lanes(|i| v[i].z)))
+    }
+
+    #[inline(always)]
+    pub fn lane(&self, i: usize) -> Vec3 {
+        Vec3::new(self.x.0[i], self.y.0[i], self.z.0[i])
+    }
+
+    /// glam's `dot`: (x x' + y y') + z z'.
+    #[inline(always)]
+    pub fn dot(self, o: V3) -> F8 {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// glam's `cross`.
+    #[inline(always)]
+    pub fn cross(self, o: V3) -> V3 {
+        V3::new(self.y * o.z - o.y * self.z, self.z * o.x - o.z * self.x, self.x * o.y - o.x * self.y)
+    }
+
+    /// glam's `normalize`: v · (1 / √(v · v)).
+    #[inline(always)]
+    pub fn normalize(self) -> V3 {
+        self * (1.0 / self.dot(self).sqrt())
+    }
+
+    /// glam's `max_element`: max(x, max(y, z)) by `>`.
+    #[inline(always)]
+    pub fn max_element(self) -> F8 {
+        let max = |a: F8, b: F8| F8::select(a.gt(b), a, b);
+        max(self.x, max(self.y, self.z))
+    }
+
+    #[inline(always)]
+    pub fn select(m: M8, a: V3, b: V3) -> V3 {
+        V3::new(F8::select(m, a.x, b.x), F8::select(m, a.y, b.y), F8::select(m, a.z, b.z))
+    }
+}
+
+impl Add for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn add(self, o: V3) -> V3 {
+        V3::new(self.x + o.x, self.y + o.y, self.z + o.z)
+    }
+}
+
+impl Sub for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn sub(self, o: V3) -> V3 {
+        V3::new(self.x - o.x, self.y - o.y, self.z - o.z)
+    }
+}
+
+impl Mul for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn mul(self, o: V3) -> V3 {
+        V3::new(self.x * o.x, self.y * o.y, self.z * o.z)
+    }
+}
+
+impl Mul<F8> for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn mul(self, s: F8) -> V3 {
+        V3::new(self.x * s, self.y * s, self.z * s)
+    }
+}
+
+impl Mul<V3> for F8 {
+    type Output = V3;
+    #[inline(always)]
+    fn mul(self, v: V3) -> V3 {
+        V3::new(self * v.x, self * v.y, self * v.z)
+    }
+}
+
+impl Div<F8> for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn div(self, s: F8) -> V3 {
+        V3::new(self.x / s, self.y / s, self.z / s)
+    }
+}
+
+impl Neg for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn neg(self) -> V3 {
+        V3::new(-self.x, -self.y, -self.z)
+    }
+}

@@ -1,0 +1,93 @@
+//! The CPU engine's fast path (packets of paths through the integrator's stages, `cpu::lanes`)
+//! renders the reference kernel's films bit for bit: every scene and setting that changes
+//! what a path does — light samplers, samplers, strategies, glass, textures with alpha,
+//! instancing, punctual lights, environments, AOVs, adaptive sampling, clamping, tiles, a lens
+//! — and images whose width is not a multiple of the packet, so that packets are partial.
+
+mod common;
+
+use common::scenes::features_scene;
+use std::path::Path;
+use veach::cpu::Kernel;
+use veach::{Backend, LightSampler, Renderer, SamplerKind, Settings, Strategy, Tile};
+
+/// The film words of `spp` samples of `scene` with `kernel`.
+fn film(scene: &Path, settings: &Settings, spp: u32, kernel: Kernel) -> Vec<u32> {
+    let (s, camera) = common::load_pair(scene, settings.camera.as_deref()).expect("scene loads");
+    let packed = veach::PackedScene::new(&s);
+    let mut r = Renderer::new(packed, &camera, settings, Backend::Cpu).expect("renderer");
+    r.set_cpu_kernel(kernel);
+    r.render_samples(0, spp).expect("render");
+    r.film().expect("film").data
+}
+
+fn base(width: u32, height: u32, max_depth: u32) -> Settings {
+    Settings { width, height, max_depth, seed: 11, ..Settings::default() }
+}
+
+#[test]
+fn packets_of_paths_render_the_reference_films_bit_for_bit() {
+    let features = features_scene("lanes");
+    let asset = common::asset;
+    let mut cases: Vec<(String, std::path::PathBuf, Settings, u32)> = vec![
+        ("cornell tree sobol".into(), asset("cornell-box.gltf"), base(45, 37, 8), 4),
+        (
+            "cornell power independent".into(),
+            asset("cornell-box.gltf"),
+            Settings { sampler: SamplerKind::Independent, light_sampler: LightSampler::Power, ..base(40, 24, 8) },
+            4,
+        ),
+        (
+            "cornell unlimited depth, clamped".into(),
+            asset("cornell-box.gltf"),
+            Settings { clamp_direct: Some(2.0), clamp_indirect: Some(0.5), ..base(33, 17, 0) },
+            3,
+        ),
+        (
+            "glass with AOVs".into(),
+            asset("cornell-glass.gltf"),
+            Settings {
+                aovs: vec![veach::aov::Aov::Albedo, veach::aov::Aov::Normal, veach::aov::Aov::Depth],
+                ..base(41, 41, 8)
+            },
+            4,
+        ),
+        ("furnace".into(), asset("furnace-a080.gltf"), base(24, 24, 8), 4),
+        (
+            "cornell adaptive".into(),
+            asset("cornell-box.gltf"),
+            Settings { noise_threshold: Some(0.2), min_samples: Some(4), ..base(32, 32, 8) },
+            20,
+        ),
+        (
+            "cornell tile and lens".into(),
+            asset("cornell-box.gltf"),
+            Settings { tile: Some(Tile { x: 13, y: 7, width: 29, height: 21 }), aperture: 0.05, ..base(64, 48, 8) },
+            3,
+        ),
+    ];
+    for strategy in [Strategy::MisPower, Strategy::MisBalance, Strategy::Bsdf, Strategy::Light] {
+        cases.push((
+            format!("veach {strategy:?}"),
+            asset("veach-mis.gltf"),
+            Settings { strategy, ..base(44, 30, 2) },
+            4,
+        ));
+    }
+    for light_sampler in LightSampler::ALL {
+        cases.push((
+            format!("features {light_sampler:?}"),
+            features.clone(),
+            Settings { env_color: Some([0.2, 0.25, 0.3]), light_sampler, ..base(47, 35, 6) },
+            4,
+        ));
+    }
+    for (name, scene, settings, spp) in &cases {
+        let lanes = film(scene, settings, *spp, Kernel::Lanes);
+        let reference = film(scene, settings, *spp, Kernel::Reference);
+        assert!(lanes.iter().any(|&w| w != 0), "{name}: the film is empty");
+        let differing = lanes.iter().zip(&reference).filter(|(a, b)| a != b).count();
+        assert_eq!(differing, 0, "{name}: {differing} film words differ between the kernels");
+        assert_eq!(lanes.len(), reference.len(), "{name}: film sizes");
+    }
+}
