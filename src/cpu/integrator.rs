@@ -412,8 +412,26 @@ pub fn path_continue(params: &Params, path: &mut PathState, sv: &SurfaceVertex, 
     true
 }
 
-/// Runs `path` to its end through the stages: the scalar reference integrator.
+/// Runs `path` to its end through the stages: the scalar reference integrator. On x86-64
+/// CPUs with AVX2 (checked at run time) the stages run compiled for it: the same operations,
+/// so the same bits, in VEX encoding.
 pub fn trace_path(scene: &PackedScene, params: &Params, path: &mut PathState) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above).
+        return unsafe { trace_path_avx2(scene, params, path) };
+    }
+    trace_path_stages(scene, params, path)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn trace_path_avx2(scene: &PackedScene, params: &Params, path: &mut PathState) {
+    trace_path_stages(scene, params, path)
+}
+
+#[inline(always)]
+fn trace_path_stages(scene: &PackedScene, params: &Params, path: &mut PathState) {
     loop {
         let hit = intersect_closest(scene, &path.ray);
         path.depth += 1;

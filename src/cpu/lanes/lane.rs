@@ -25,9 +25,15 @@ pub struct U8(pub [u32; W]);
 #[repr(C, align(32))]
 pub struct M8(pub [u32; W]);
 
+/// `[f(0), …, f(W − 1)]` as a plain loop over an array, the shape LLVM vectorises (the
+/// iterator inside `std::array::from_fn` it does not).
 #[inline(always)]
-fn lanes<T>(f: impl FnMut(usize) -> T) -> [T; W] {
-    std::array::from_fn(f)
+fn lanes<T: Copy + Default>(mut f: impl FnMut(usize) -> T) -> [T; W] {
+    let mut out = [T::default(); W];
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = f(i);
+    }
+    out
 }
 
 impl F8 {
