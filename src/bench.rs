@@ -2,7 +2,7 @@
 //! load and BVH-build times, device memory per triangle, and the BVH's traversal throughput
 //! for primary, shadow and diffuse-bounce rays. Timing only: nothing here asserts.
 
-use crate::cpu::bvh::{intersect_closest, offset_ray};
+use crate::cpu::bvh::{intersect_closest, intersect_closest_batch, occluded_batch, offset_ray};
 use crate::cpu::common::Ray;
 use crate::cpu::frame::{frame_from_normal, from_local};
 use crate::cpu::sampling::sample_cosine_hemisphere;
@@ -228,20 +228,15 @@ pub fn run(opts: &BenchOptions, backends: &[Backend], progress: &mut dyn FnMut(&
 /// (`sample_light`, `unoccluded`, as the integrator connects) and a cosine-distributed bounce
 /// ray, each drawn from the sampler right after the camera ray, as each trace kernel does.
 fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<RayResult> {
-    use crate::cpu::integrator::unoccluded;
+    use crate::cpu::integrator::shadow_ray;
     use crate::cpu::sampler::{sample_1d, sample_2d};
     let (w, h) = (params.image_width, params.image_height);
     let first = crate::params::Params { sample_index: 0, ..*params };
     let primary: Vec<_> =
         (0..w * h).map(|i| crate::cpu::camera::camera_sample(&first, glam::UVec2::new(i % w, i / w))).collect();
     let hits: Vec<_> = primary.par_iter().map(|(r, _)| intersect_closest(scene, r)).collect();
-    let primary_result = RayResult::new(
-        "primary",
-        primary.len(),
-        best_of(|| {
-            std::hint::black_box(primary.par_iter().map(|(r, _)| intersect_closest(scene, r).t).sum::<f32>());
-        }),
-    );
+    let primary_rays: Vec<Ray> = primary.iter().map(|(r, _)| *r).collect();
+    let primary_result = RayResult::new("primary", primary.len(), best_of(|| closest_batches(scene, &primary_rays)));
     // Surface points and their normals facing the camera, and each path's sampler.
     let surface: Vec<_> = primary
         .iter()
@@ -274,11 +269,21 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<Ra
     } else {
         Vec::new()
     };
+    let (shadow_rays, shadow_ends): (Vec<Ray>, Vec<f32>) = shadow.iter().map(|(o, ls)| shadow_ray(*o, ls)).unzip();
     let shadow_result = RayResult::new(
         "shadow",
         shadow.len(),
         best_of(|| {
-            std::hint::black_box(shadow.par_iter().filter(|(o, ls)| unoccluded(scene, *o, ls)).count());
+            let blocked: usize = shadow_rays
+                .par_chunks(BATCH)
+                .zip(shadow_ends.par_chunks(BATCH))
+                .map(|(rays, ends)| {
+                    let mut blocked = [false; BATCH];
+                    occluded_batch(scene, rays, ends, &mut blocked[..rays.len()]);
+                    blocked.iter().filter(|&&b| b).count()
+                })
+                .sum();
+            std::hint::black_box(blocked);
         }),
     );
     let diffuse: Vec<Ray> = surface
@@ -289,14 +294,24 @@ fn ray_throughput(scene: &PackedScene, params: &crate::params::Params) -> Vec<Ra
             Ray { origin: offset_ray(*p, *ng), dir: wi }
         })
         .collect();
-    let diffuse_result = RayResult::new(
-        "diffuse",
-        diffuse.len(),
-        best_of(|| {
-            std::hint::black_box(diffuse.par_iter().map(|r| intersect_closest(scene, r).t).sum::<f32>());
-        }),
-    );
+    let diffuse_result = RayResult::new("diffuse", diffuse.len(), best_of(|| closest_batches(scene, &diffuse)));
     vec![primary_result, shadow_result, diffuse_result]
+}
+
+/// Rays per batch query in the throughput measure.
+const BATCH: usize = 256;
+
+/// The closest hits of `rays` through the batch query, batches in parallel.
+fn closest_batches(scene: &PackedScene, rays: &[Ray]) {
+    let t: f32 = rays
+        .par_chunks(BATCH)
+        .map(|rays| {
+            let mut hits = [crate::cpu::bvh::Hit { t: 0.0, tri: 0, u: 0.0, v: 0.0, instance: 0 }; BATCH];
+            intersect_closest_batch(scene, rays, &mut hits[..rays.len()]);
+            hits[..rays.len()].iter().map(|h| h.t).sum::<f32>()
+        })
+        .sum();
+    std::hint::black_box(t);
 }
 
 /// Seconds of one run of `f`: the fastest of at least 5 runs and 0.3 s (a batch of ~65k rays

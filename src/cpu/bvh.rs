@@ -473,6 +473,23 @@ pub fn occluded(scene: &PackedScene, ray: &Ray, t_max: f32) -> bool {
     trace(scene, ray, t_max, true).tri != NO_HIT
 }
 
+/// The closest hits of a batch of rays, `hits[i]` for `rays[i]` (rays in order; a batch API
+/// for engines and tools that trace many rays at once: the benchmark's throughput, a
+/// wavefront's stage).
+pub fn intersect_closest_batch(scene: &PackedScene, rays: &[Ray], hits: &mut [Hit]) {
+    for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+        *hit = intersect_closest(scene, ray);
+    }
+}
+
+/// Occlusion of a batch of segments: `blocked[i]` when something lies on `rays[i]` before
+/// `t_max[i]` (any hit).
+pub fn occluded_batch(scene: &PackedScene, rays: &[Ray], t_max: &[f32], blocked: &mut [bool]) {
+    for ((ray, &t), b) in rays.iter().zip(t_max).zip(blocked.iter_mut()) {
+        *b = occluded(scene, ray, t);
+    }
+}
+
 pub fn offset_ray(p: Vec3, n: Vec3) -> Vec3 {
     let of_i = (256.0 * n).as_ivec3();
     let bump =

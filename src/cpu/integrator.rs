@@ -76,11 +76,20 @@ pub fn connect_evaluated(
 
 /// Whether nothing blocks the segment from `origin` to the light sample (twin of `unoccluded`).
 pub fn unoccluded(scene: &PackedScene, origin: Vec3, ls: &LightSample) -> bool {
+    let (ray, t_max) = shadow_ray(origin, ls);
+    !occluded(scene, &ray, t_max)
+}
+
+/// The shadow ray from `origin` to the light sample and its extent: towards an environment
+/// or a distant light without end; to an emitter's point, moved just off its surface, as the
+/// segment's parameter 1.
+#[inline(always)]
+pub fn shadow_ray(origin: Vec3, ls: &LightSample) -> (Ray, f32) {
     if ls.dist == INF {
-        return !occluded(scene, &Ray { origin, dir: ls.wi }, INF);
+        return (Ray { origin, dir: ls.wi }, INF);
     }
     let target = offset_ray(ls.point, ls.normal);
-    !occluded(scene, &Ray { origin, dir: target - origin }, 1.0)
+    (Ray { origin, dir: target - origin }, 1.0)
 }
 
 /// Twin of `clamp_contribution`: firefly control, a contribution carried by a path of

@@ -207,24 +207,23 @@ pub(crate) fn group_shares(
     ctx: &LightContext,
     g: &LightGroup,
 ) -> Option<[f32; 4]> {
+    let _ = (scene, params);
     let (far, near) = group_importance(ctx, g);
-    let (mut far, mut near) = (far.to_array(), near.to_array());
-    for lane in 0..4 {
-        let next = g.next[lane];
-        let emitter = next & !(LIGHT_LEAF | LIGHT_TWO_SIDED);
-        if far[lane] > 0.0 && next & (LIGHT_LEAF | LIGHT_TWO_SIDED) == LIGHT_LEAF && emitter < params.light_count {
-            let [p0, n] = scene.light_planes[emitter as usize];
-            if n.dot(ctx.point - p0) <= 0.0 {
-                (far[lane], near[lane]) = (0.0, 0.0);
-            }
-        }
-    }
+    // A one-sided leaf triangle whose plane the point is behind (`child_importance`'s test,
+    // the four slots at once: n · (p − p0) lane by lane in the scalar order).
+    let p = [Vec4::splat(ctx.point.x), Vec4::splat(ctx.point.y), Vec4::splat(ctx.point.z)];
+    let to_p = [0, 1, 2].map(|k| p[k] - Vec4::from(g.plane_p0[k]));
+    let side = dot3(g.plane_n.map(Vec4::from), to_p);
+    let one_sided = BVec4A::from_array(g.one_sided.map(|m| m != 0));
+    let behind = far.cmpgt(Vec4::ZERO) & one_sided & side.cmple(Vec4::ZERO);
+    let (far, near) = (Vec4::select(behind, Vec4::ZERO, far), Vec4::select(behind, Vec4::ZERO, near));
     // In slot order, as the kernel adds them.
-    let total = Vec2::new(((far[0] + far[1]) + far[2]) + far[3], ((near[0] + near[1]) + near[2]) + near[3]);
+    let total = Vec2::new(((far.x + far.y) + far.z) + far.w, ((near.x + near.y) + near.z) + near.w);
     if total.x.is_nan() || total.x <= 0.0 {
         return None;
     }
-    Some([0, 1, 2, 3].map(|k| child_share(Vec2::new(far[k], near[k]), total)))
+    // `child_share` of the four slots: 0.5 (far / total far + near / total near).
+    Some((Vec4::splat(0.5) * (far / Vec4::splat(total.x) + near / Vec4::splat(total.y))).to_array())
 }
 
 /// The slot `u` chooses among children with `shares` (of which at least one is positive),

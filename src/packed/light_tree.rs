@@ -156,6 +156,31 @@ pub struct LightGroup {
     /// Per slot: a leaf's emitter | LIGHT_LEAF | LIGHT_TWO_SIDED, or an interior child's
     /// own group index | LIGHT_TWO_SIDED.
     pub next: [u32; 4],
+    /// Per slot holding a one-sided emissive triangle (a leaf, not two-sided, an emitter
+    /// below the scene's light count): all bits set, and the triangle's plane (a vertex and
+    /// e1 × e2, as `PackedScene::light_planes` has them), so that the walk tests the four
+    /// slots' planes at once (`attach_planes`).
+    pub one_sided: [u32; 4],
+    pub plane_p0: [[f32; 4]; 3],
+    pub plane_n: [[f32; 4]; 3],
+}
+
+/// Fills the groups' per-slot triangle planes from `planes` (one per emissive triangle).
+pub fn attach_planes(groups: &mut [LightGroup], planes: &[[Vec3; 2]]) {
+    for g in groups {
+        for lane in 0..LIGHT_TREE_WIDTH {
+            let next = g.next[lane];
+            let emitter = (next & !(LIGHT_LEAF | LIGHT_TWO_SIDED)) as usize;
+            if next & (LIGHT_LEAF | LIGHT_TWO_SIDED) == LIGHT_LEAF && emitter < planes.len() {
+                let [p0, n] = planes[emitter];
+                g.one_sided[lane] = u32::MAX;
+                for k in 0..3 {
+                    g.plane_p0[k][lane] = p0[k];
+                    g.plane_n[k][lane] = n[k];
+                }
+            }
+        }
+    }
 }
 
 /// The groups of the tree whose node rows are `rows` (`nodes` records, axes decoded in

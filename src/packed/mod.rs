@@ -327,6 +327,7 @@ impl PackedScene {
                 [Vec3::from(t.p0), Vec3::from(t.e1).cross(Vec3::from(t.e2))]
             })
             .collect();
+        light_tree::attach_planes(&mut packed.light_groups, &packed.light_planes);
         packed.set_environment(&scene.environment);
         packed
     }
