@@ -54,7 +54,7 @@ impl Engine for cpu::Renderer {
 
     fn adapter_name(&self) -> String {
         match self.kernel() {
-            cpu::Kernel::Reference => format!("cpu ({} threads)", rayon::current_num_threads()),
+            cpu::Kernel::Lanes => format!("cpu ({} threads)", rayon::current_num_threads()),
             k => format!("cpu ({} threads, {} kernel)", rayon::current_num_threads(), k.name()),
         }
     }

@@ -26,11 +26,11 @@ use std::borrow::Cow;
 /// A path's colour channel before it meets a dispersive surface: all three.
 pub const ALL_CHANNELS: u32 = 3;
 
-fn same_side(wi: Vec3, ng: Vec3, wi_local: Vec3) -> bool {
+pub fn same_side(wi: Vec3, ng: Vec3, wi_local: Vec3) -> bool {
     (wi.dot(ng) > 0.0) == (wi_local.z > 0.0)
 }
 
-fn spawn_point(point: Vec3, ng: Vec3, wi: Vec3) -> Vec3 {
+pub fn spawn_point(point: Vec3, ng: Vec3, wi: Vec3) -> Vec3 {
     offset_ray(point, if wi.dot(ng) > 0.0 { ng } else { -ng })
 }
 

@@ -21,22 +21,20 @@ pub struct Renderer {
 /// How the CPU engine runs the integrator: the same films either way, bit for bit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kernel {
-    /// One path at a time through `li`: the reference the GPU kernel is held to, and today
-    /// the faster of the two (BENCHMARKS.md, session 18), so the default.
+    /// One path at a time through `li`: the reference the GPU kernel is held to.
     Reference,
-    /// Packets of eight paths through the same stages (`cpu::lanes`), plain materials' BSDF
-    /// in SIMD lanes: the groundwork of paths in lanes, 4–12 % slower while the packet's
-    /// state is gathered from and scattered to per-path records at every stage.
+    /// Packets of eight paths with their state in SIMD lanes (`cpu::lanes`): the default, the
+    /// faster one (BENCHMARKS.md, session 18).
     Lanes,
 }
 
 impl Kernel {
-    /// `Reference`, unless the environment variable VEACH_CPU_KERNEL says `lanes` (for
+    /// `Lanes`, unless the environment variable VEACH_CPU_KERNEL says `reference` (for
     /// benchmarks of the two in one build).
     pub fn from_env() -> Kernel {
         match std::env::var("VEACH_CPU_KERNEL").as_deref() {
-            Ok("lanes") => Kernel::Lanes,
-            _ => Kernel::Reference,
+            Ok("reference") => Kernel::Reference,
+            _ => Kernel::Lanes,
         }
     }
 

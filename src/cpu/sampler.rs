@@ -29,6 +29,17 @@ pub fn sampler_init(kind: u32, pixel: u32, sample_index: u32, seed: u32) -> Samp
     Sampler { kind, pixel_seed: pcg_hash(pixel ^ pcg_hash(seed ^ 0x5bd1e995)), index: sample_index, dim: 0, state: 0 }
 }
 
+/// The sampler's words (kind, pixel seed, sample index, dimension, PCG state), for samplers
+/// kept in lanes (`cpu::lanes::sampler`).
+pub fn sampler_parts(s: &Sampler) -> (u32, u32, u32, u32, u32) {
+    (s.kind, s.pixel_seed, s.index, s.dim, s.state)
+}
+
+/// The sampler of `sampler_parts`' words.
+pub fn sampler_from_parts(kind: u32, pixel_seed: u32, index: u32, dim: u32, state: u32) -> Sampler {
+    Sampler { kind, pixel_seed, index, dim, state }
+}
+
 pub fn laine_karras(v: u32, seed: u32) -> u32 {
     let mut x = v;
     x ^= x.wrapping_mul(0x3d20adea);

@@ -196,6 +196,11 @@ impl M8 {
     pub fn lane(self, i: usize) -> bool {
         self.0[i] != 0
     }
+
+    #[inline(always)]
+    pub fn set_lane(&mut self, i: usize, b: bool) {
+        self.0[i] = if b { u32::MAX } else { 0 };
+    }
 }
 
 impl BitAnd for M8 {
@@ -243,6 +248,16 @@ impl U8 {
         U8(lanes(|i| f(self.0[i], o.0[i])))
     }
 
+    #[inline(always)]
+    pub fn gt(self, x: u32) -> M8 {
+        M8(lanes(|i| if self.0[i] > x { u32::MAX } else { 0 }))
+    }
+
+    #[inline(always)]
+    pub fn ge(self, x: u32) -> M8 {
+        M8(lanes(|i| if self.0[i] >= x { u32::MAX } else { 0 }))
+    }
+
     /// (x >> 8) / 2²⁴: a float in [0, 1) from the top 24 bits (`unit_float`), converted as a
     /// signed integer (exact below 2²⁴, one instruction on x86).
     #[inline(always)]
@@ -280,6 +295,11 @@ impl V3 {
     #[inline(always)]
     pub fn lane(&self, i: usize) -> Vec3 {
         Vec3::new(self.x.0[i], self.y.0[i], self.z.0[i])
+    }
+
+    #[inline(always)]
+    pub fn set_lane(&mut self, i: usize, v: Vec3) {
+        (self.x.0[i], self.y.0[i], self.z.0[i]) = (v.x, v.y, v.z);
     }
 
     /// glam's `dot`: (x x' + y y') + z z'.

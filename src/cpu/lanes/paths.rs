@@ -1,0 +1,416 @@
+//! A packet's paths with their state in lanes (structure of arrays), and the integrator's loop
+//! over them. Each bounce, the lanes whose surface the lanes cover ("plain": `plain_material`)
+//! go through `bounce_plain`, which is `path_surface`, `path_next_event` and `path_scatter`
+//! written over lanes, operation for operation; every other lane (textures, layers, glass,
+//! instances, AOVs, vertex colours, separately sampled punctual lights, environment hits) is
+//! taken out of the lanes as a `PathState`, advanced by the scalar stages, and put back. What
+//! stays per lane inside `bounce_plain` is what branches per path: the BVH walks, light
+//! selection and the light sample, an emitter hit's light density, the shadow test.
+
+use super::bsdf::{BaseLanes, base_eval, base_pdf, base_sample, is_plain};
+use super::lane::{F8, M8, U8, V3};
+use super::light_tree::sample_light_tree_lanes;
+use super::sampler::SamplerLanes;
+use super::{LANES, lanes_of};
+use crate::Strategy;
+use crate::aov::AovSample;
+use crate::cpu::bvh::{Hit, NO_HIT, intersect_closest};
+use crate::cpu::common::{INF, Ray};
+use crate::cpu::integrator::{
+    PathState, connect_evaluated, next_event_wanted, path_escaped, path_next_event, path_scatter, path_strategy,
+    path_surface, spawn_point,
+};
+use crate::cpu::light_tree::LightContext;
+use crate::cpu::lights::{LightSample, light_pdf, sample_light_chosen, tree_u};
+use crate::cpu::material::shading_normal;
+use crate::packed::{Material, PackedScene, TRI_HAS_NORMALS, TRI_MIRRORED};
+use crate::params::Params;
+use glam::{Vec3, Vec4};
+
+/// `PathState` of a packet, lane by lane.
+#[derive(Clone, Copy, Debug)]
+pub struct Paths {
+    pub origin: V3,
+    pub dir: V3,
+    pub radiance: V3,
+    pub beta: V3,
+    pub depth: U8,
+    pub prev_pdf: F8,
+    pub prev_delta: M8,
+    pub prev_point: V3,
+    pub prev_normal: V3,
+    pub prev_reflect_only: M8,
+    pub aov_open: M8,
+    pub aov_weight: V3,
+    pub aov: [AovSample; LANES],
+    pub channel: U8,
+    pub sampler: SamplerLanes,
+}
+
+impl Paths {
+    pub fn from_states(s: &[PathState; LANES]) -> Paths {
+        let mask = |f: &dyn Fn(&PathState) -> bool| M8(std::array::from_fn(|i| if f(&s[i]) { u32::MAX } else { 0 }));
+        Paths {
+            origin: V3::from_fn(|i| s[i].ray.origin),
+            dir: V3::from_fn(|i| s[i].ray.dir),
+            radiance: V3::from_fn(|i| s[i].radiance),
+            beta: V3::from_fn(|i| s[i].beta),
+            depth: U8::from_fn(|i| s[i].depth),
+            prev_pdf: F8::from_fn(|i| s[i].prev_pdf),
+            prev_delta: mask(&|p| p.prev_delta),
+            prev_point: V3::from_fn(|i| s[i].prev_ctx.point),
+            prev_normal: V3::from_fn(|i| s[i].prev_ctx.normal),
+            prev_reflect_only: mask(&|p| p.prev_ctx.reflect_only),
+            aov_open: mask(&|p| p.aov_open),
+            aov_weight: V3::from_fn(|i| s[i].aov_weight),
+            aov: std::array::from_fn(|i| s[i].aov),
+            channel: U8::from_fn(|i| s[i].channel),
+            sampler: SamplerLanes::from_samplers(&std::array::from_fn(|i| s[i].sampler)),
+        }
+    }
+
+    /// Lane i as a scalar path.
+    pub fn lane(&self, i: usize) -> PathState {
+        PathState {
+            ray: Ray { origin: self.origin.lane(i), dir: self.dir.lane(i) },
+            radiance: self.radiance.lane(i),
+            beta: self.beta.lane(i),
+            depth: self.depth.0[i],
+            prev_pdf: self.prev_pdf.0[i],
+            prev_delta: self.prev_delta.lane(i),
+            prev_ctx: LightContext {
+                point: self.prev_point.lane(i),
+                normal: self.prev_normal.lane(i),
+                reflect_only: self.prev_reflect_only.lane(i),
+            },
+            aov_open: self.aov_open.lane(i),
+            aov_weight: self.aov_weight.lane(i),
+            aov: self.aov[i],
+            channel: self.channel.0[i],
+            sampler: self.sampler.lane(i),
+        }
+    }
+
+    /// Lane i becomes the scalar path `p`.
+    pub fn set_lane(&mut self, i: usize, p: &PathState) {
+        self.origin.set_lane(i, p.ray.origin);
+        self.dir.set_lane(i, p.ray.dir);
+        self.radiance.set_lane(i, p.radiance);
+        self.beta.set_lane(i, p.beta);
+        self.depth.0[i] = p.depth;
+        self.prev_pdf.0[i] = p.prev_pdf;
+        self.prev_delta.set_lane(i, p.prev_delta);
+        self.prev_point.set_lane(i, p.prev_ctx.point);
+        self.prev_normal.set_lane(i, p.prev_ctx.normal);
+        self.prev_reflect_only.set_lane(i, p.prev_ctx.reflect_only);
+        self.aov_open.set_lane(i, p.aov_open);
+        self.aov_weight.set_lane(i, p.aov_weight);
+        self.aov[i] = p.aov;
+        self.channel.0[i] = p.channel;
+        self.sampler.set_lane(i, &p.sampler);
+    }
+}
+
+/// Runs the paths of `alive` to their ends. On x86-64 CPUs with AVX2 (checked at run time) it
+/// runs compiled for AVX2, so the lanes' arithmetic is one instruction for the packet; the
+/// operations, hence the bits, are the same either way.
+pub fn trace_paths(scene: &PackedScene, params: &Params, paths: &mut Paths, alive: u32) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above).
+        return unsafe { trace_paths_avx2(scene, params, paths, alive) };
+    }
+    trace_paths_loop(scene, params, paths, alive)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn trace_paths_avx2(scene: &PackedScene, params: &Params, paths: &mut Paths, alive: u32) {
+    trace_paths_loop(scene, params, paths, alive)
+}
+
+/// Can `bounce_plain` take a hit on material `m` (its index `index`) in this scene?
+#[inline(always)]
+fn plain_material(scene: &PackedScene, params: &Params, m: &Material, index: usize) -> bool {
+    // (A material is the stored one at every point without textures or vertex colours.)
+    scene.instance_count == 0
+        && scene.extras_base == 0
+        && params.separate_punctuals == 0
+        && !scene.material_textured[index]
+        && is_plain(m)
+        && Vec3::from(m.attenuation).max_element() <= 0.0
+}
+
+#[inline(always)]
+fn trace_paths_loop(scene: &PackedScene, params: &Params, paths: &mut Paths, mut alive: u32) {
+    let mut hits = [Hit { t: INF, tri: NO_HIT, u: 0.0, v: 0.0, instance: 0 }; LANES];
+    while alive != 0 {
+        for i in lanes_of(alive) {
+            hits[i] = intersect_closest(scene, &Ray { origin: paths.origin.lane(i), dir: paths.dir.lane(i) });
+            paths.depth.0[i] += 1;
+        }
+        let mut plain = 0u32;
+        for i in lanes_of(alive) {
+            let hit = &hits[i];
+            if hit.tri == NO_HIT {
+                let mut p = paths.lane(i);
+                path_escaped(scene, params, &mut p);
+                paths.set_lane(i, &p);
+                alive &= !(1 << i);
+                continue;
+            }
+            let mi = scene.triangles[hit.tri as usize].material as usize;
+            if !paths.aov_open.lane(i) && plain_material(scene, params, &scene.materials[mi], mi) {
+                plain |= 1 << i;
+                continue;
+            }
+            // The scalar stages, for this lane's whole bounce.
+            let mut p = paths.lane(i);
+            let goes_on = match path_surface(scene, params, &mut p, hit) {
+                Some(sv) => {
+                    path_next_event(scene, params, &mut p, &sv);
+                    path_scatter(params, &mut p, &sv)
+                }
+                None => false,
+            };
+            paths.set_lane(i, &p);
+            if !goes_on {
+                alive &= !(1 << i);
+            }
+        }
+        if plain != 0 {
+            let survivors = bounce_plain(scene, params, paths, &hits, plain);
+            alive = (alive & !plain) | survivors;
+        }
+    }
+}
+
+/// `clamp_contribution` in lanes, `segments` per lane.
+#[inline(always)]
+fn clamp_contribution(params: &Params, c: V3, segments: U8) -> V3 {
+    let limit = F8::from_fn(|i| if segments.0[i] <= 2 { params.clamp_direct } else { params.clamp_indirect });
+    let sum = c.x + c.y + c.z;
+    V3::select(sum.gt(limit), c * (limit / sum), c)
+}
+
+/// `mis_weight` in lanes.
+#[inline(always)]
+fn mis_weight(strategy: Strategy, pdf_f: F8, pdf_g: F8) -> F8 {
+    let w = match strategy {
+        Strategy::MisBalance => 1.0 / (1.0 + pdf_g / pdf_f),
+        _ => {
+            let r = pdf_g / pdf_f;
+            1.0 / (1.0 + r * r)
+        }
+    };
+    F8::select(pdf_f.le(F8::splat(0.0)), F8::splat(0.0), w)
+}
+
+/// `frame_from_normal` in lanes: (t, b, n).
+#[inline(always)]
+fn frame_from_normal(n: V3) -> [V3; 3] {
+    let one = F8::splat(1.0);
+    let s = F8::select(n.z.ge(F8::splat(0.0)), one, F8::splat(-1.0));
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    let t = V3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
+    let bt = V3::new(b, s + n.y * n.y * a, -n.y);
+    [t, bt, n]
+}
+
+#[inline(always)]
+fn to_local(f: &[V3; 3], v: V3) -> V3 {
+    V3::new(v.dot(f[0]), v.dot(f[1]), v.dot(f[2]))
+}
+
+#[inline(always)]
+fn from_local(f: &[V3; 3], v: V3) -> V3 {
+    f[0] * v.x + f[1] * v.y + f[2] * v.z
+}
+
+#[inline(always)]
+fn luminance(c: V3) -> F8 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// `lobe_probabilities` of plain materials (`bsdf::lobe_weights` with their transmission and
+/// diffuse transmission, both without a lobe).
+#[inline(always)]
+fn lobe_probabilities(m: &BaseLanes, cos_o: F8, eta: F8) -> [F8; 4] {
+    use super::bsdf::{bsdf_fresnel, dielectric_fresnel, diffuse_albedo};
+    let zero = F8::splat(0.0);
+    let one = V3::splat(Vec3::ONE);
+    let alpha = m.roughness * m.roughness;
+    let transmitted = (1.0 - m.metallic) * m.transmission * m.base_color * (one - dielectric_fresnel(m, cos_o));
+    let mut wt = luminance(transmitted);
+    let rough = (alpha * (1.0 - 1.0 / eta).abs()).ge(F8::splat(crate::cpu::microfacet::DELTA_ALPHA));
+    let floor = 0.1 * (1.0 - m.metallic) * m.transmission * luminance(m.base_color);
+    wt = F8::select(rough, wt.max_num(floor), wt);
+    // luminance(0) of the absent diffuse transmission.
+    let w = [luminance(bsdf_fresnel(m, cos_o)), luminance(diffuse_albedo(m, cos_o)), wt, zero * 0.2126];
+    let total = w[0] + w[1] + w[2] + w[3];
+    let none = total.le(zero);
+    w.map(|x| F8::select(none, zero, x / total))
+}
+
+/// One bounce of the lanes of `lanes` (plain surfaces hit): `path_surface`, `path_next_event`
+/// and `path_scatter` of `integrator.rs`, the same operations lane by lane. Returns the lanes
+/// that go on.
+#[inline(always)]
+fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &[Hit; LANES], lanes: u32) -> u32 {
+    let strategy = path_strategy(params);
+    let on = M8::from_bits(lanes);
+    let zero = F8::splat(0.0);
+    let index = |i: usize| if lanes >> i & 1 != 0 { hits[i].tri as usize } else { 0 };
+    let tri = |i: usize| &scene.triangles[index(i)];
+    let mat = |i: usize| &scene.materials[tri(i).material as usize];
+
+    // The surface: the triangle's point and normals, the material.
+    let p0 = V3::from_fn(|i| Vec3::from(tri(i).p0));
+    let e1 = V3::from_fn(|i| Vec3::from(tri(i).e1));
+    let e2 = V3::from_fn(|i| Vec3::from(tri(i).e2));
+    let (u, v, t) = (F8::from_fn(|i| hits[i].u), F8::from_fn(|i| hits[i].v), F8::from_fn(|i| hits[i].t));
+    let point = p0 + u * e1 + v * e2;
+    let ng_cross = e1.cross(e2).normalize();
+    let mirrored = M8(std::array::from_fn(|i| if tri(i).flags & TRI_MIRRORED != 0 { u32::MAX } else { 0 }));
+    let ng_raw = V3::select(mirrored, -ng_cross, ng_cross);
+    let dir = paths.dir;
+    let cos_hit = dir.dot(ng_raw);
+    let base = BaseLanes::gather(|i| (lanes >> i & 1 != 0).then(|| mat(i)), |_| Vec4::ZERO);
+    let emission = V3::from_fn(|i| Vec3::from(mat(i).emission));
+
+    // Emission found by the previous vertex's BSDF sample (or the camera ray).
+    let emits = on & cos_hit.lt(zero) & emission.max_element().gt(zero);
+    if emits.bits() != 0 {
+        let weighed = emits & paths.depth.gt(1) & !paths.prev_delta;
+        let mut w = F8::splat(1.0);
+        match strategy {
+            Strategy::Light => w = F8::select(weighed, zero, w),
+            Strategy::Bsdf => {}
+            _ => {
+                let mut light = [0.0f32; LANES];
+                for i in lanes_of(weighed.bits()) {
+                    let ctx = LightContext {
+                        point: paths.prev_point.lane(i),
+                        normal: paths.prev_normal.lane(i),
+                        reflect_only: paths.prev_reflect_only.lane(i),
+                    };
+                    let (d, ti) = (dir.lane(i), t.0[i]);
+                    light[i] = light_pdf(scene, params, &ctx, tri(i), d, ti * ti, cos_hit.0[i]);
+                }
+                w = F8::select(weighed, mis_weight(strategy, paths.prev_pdf, F8(light)), w);
+            }
+        }
+        let c = clamp_contribution(params, paths.beta * emission * w, paths.depth);
+        paths.radiance = V3::select(emits, paths.radiance + c, paths.radiance);
+    }
+    let last = M8::splat(params.max_depth != 0) & paths.depth.ge(params.max_depth);
+    let live = on & !last;
+    if live.bits() == 0 {
+        return 0;
+    }
+
+    let ng = V3::select(cos_hit.gt(zero), -ng_raw, ng_raw);
+    let ior = F8::from_fn(|i| mat(i).ior);
+    let eta = F8::select(cos_hit.lt(zero), ior, 1.0 / ior);
+    let mut ns = ng_raw;
+    for i in lanes_of(live.bits()) {
+        if tri(i).flags & TRI_HAS_NORMALS != 0 {
+            let n =
+                shading_normal(scene, tri(i), index(i) as u32, 0, u.0[i], v.0[i], ng_raw.lane(i), mat(i), Vec4::ZERO);
+            ns.set_lane(i, n);
+        }
+    }
+    ns = V3::select(ns.dot(dir).gt(zero), -ns, ns);
+    let frame = frame_from_normal(ns);
+    let wo = to_local(&frame, -dir);
+    let mut base = base;
+    base.p = lobe_probabilities(&base, wo.z, eta);
+
+    // Next-event estimation.
+    if next_event_wanted(params) {
+        let u0 = paths.sampler.sample_1d(live);
+        let (u1, u2) = paths.sampler.sample_2d(live);
+        let ctx = |i: usize| LightContext { point: point.lane(i), normal: ns.lane(i), reflect_only: true };
+        let mut walking = 0u32;
+        let mut u_tree = [0.0f32; LANES];
+        for i in lanes_of(live.bits()) {
+            if let Some(x) = tree_u(params, u0.0[i]) {
+                u_tree[i] = x;
+                walking |= 1 << i;
+            }
+        }
+        let contexts = std::array::from_fn(ctx);
+        let walks = sample_light_tree_lanes(scene, params, &contexts, &u_tree, walking);
+        let mut ls = [LightSample {
+            wi: Vec3::Z,
+            dist: 0.0,
+            point: Vec3::ZERO,
+            normal: Vec3::Z,
+            radiance: Vec3::ZERO,
+            pdf: 0.0,
+            delta: false,
+        }; LANES];
+        for i in lanes_of(live.bits()) {
+            let uu = Vec3::new(u0.0[i], u1.0[i], u2.0[i]);
+            ls[i] = sample_light_chosen(scene, params, &contexts[i], uu, walks[i]);
+        }
+        let delta = M8(std::array::from_fn(|i| if ls[i].delta { u32::MAX } else { 0 }));
+        let connecting = live & (delta | M8::splat(strategy != Strategy::Bsdf));
+        if connecting.bits() != 0 {
+            let wi = V3::from_fn(|i| ls[i].wi);
+            let wi_local = to_local(&frame, wi);
+            let f = base_eval(&base, wo, wi_local);
+            let pdf_b = base_pdf(&base, wo, wi_local);
+            let light_pdf = F8::from_fn(|i| ls[i].pdf);
+            let mut c = V3::splat(Vec3::ZERO);
+            for i in lanes_of(connecting.bits()) {
+                if ls[i].pdf > 0.0 {
+                    c.set_lane(
+                        i,
+                        connect_evaluated(scene, point.lane(i), ng.lane(i), &ls[i], wi_local.lane(i), f.lane(i)),
+                    );
+                }
+            }
+            let add = connecting & c.max_element().gt(zero);
+            if add.bits() != 0 {
+                let w = F8::select(
+                    M8::splat(strategy == Strategy::Light) | delta,
+                    F8::splat(1.0),
+                    mis_weight(strategy, light_pdf, pdf_b),
+                );
+                let depth1 = paths.depth.map(|d| d + 1);
+                let contribution = clamp_contribution(params, paths.beta * c * (w / light_pdf), depth1);
+                paths.radiance = V3::select(add, paths.radiance + contribution, paths.radiance);
+            }
+        }
+    }
+
+    // The BSDF sample that continues the path, then Russian roulette.
+    let u0 = paths.sampler.sample_1d(live);
+    let (u1, u2) = paths.sampler.sample_2d(live);
+    let bs = base_sample(&base, wo, V3::new(u0, u1, u2), live.bits());
+    let mut go = live & bs.pdf.gt(zero);
+    let wi = from_local(&frame, bs.wi);
+    go = go & M8(std::array::from_fn(|i| if (wi.dot(ng).0[i] > 0.0) == (bs.wi.z.0[i] > 0.0) { u32::MAX } else { 0 }));
+    paths.beta = V3::select(go, paths.beta * bs.weight, paths.beta);
+    go = go & paths.beta.max_element().gt(zero);
+    paths.prev_pdf = F8::select(go, bs.pdf, paths.prev_pdf);
+    paths.prev_delta = M8(std::array::from_fn(|i| if go.lane(i) { bs.delta.0[i] } else { paths.prev_delta.0[i] }));
+    paths.prev_point = V3::select(go, point, paths.prev_point);
+    paths.prev_normal = V3::select(go, ns, paths.prev_normal);
+    paths.prev_reflect_only = paths.prev_reflect_only | go;
+    for i in lanes_of(go.bits()) {
+        paths.origin.set_lane(i, spawn_point(point.lane(i), ng.lane(i), wi.lane(i)));
+    }
+    paths.dir = V3::select(go, wi, paths.dir);
+    let roulette = go & paths.depth.ge(params.rr_depth);
+    if roulette.bits() != 0 {
+        let q = paths.beta.max_element().min_num(F8::splat(0.95));
+        let x = paths.sampler.sample_1d(roulette);
+        let ends = roulette & x.ge(q);
+        go = go & !ends;
+        paths.beta = V3::select(roulette & !ends, paths.beta / q, paths.beta);
+    }
+    go.bits()
+}
