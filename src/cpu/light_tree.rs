@@ -142,6 +142,19 @@ fn dot3(a: [Vec4; 3], b: [Vec4; 3]) -> Vec4 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// SSE's max: `a` where a > b, else `b` (so `b` on NaN and on equal zeros), on every platform
+/// (the walk over paths in lanes, `cpu::lanes::light_tree`, computes the same).
+#[inline(always)]
+fn max_ps(a: Vec4, b: Vec4) -> Vec4 {
+    Vec4::select(a.cmpgt(b), a, b)
+}
+
+/// SSE's min: `a` where a < b, else `b`.
+#[inline(always)]
+fn min_ps(a: Vec4, b: Vec4) -> Vec4 {
+    Vec4::select(a.cmplt(b), a, b)
+}
+
 /// `node_importance` of a group's four children at once, lane by lane the same operations in
 /// the same order (so the same bits: SSE's min, max, sqrt and division round as the scalar
 /// ones do, and take the same operand on NaN): far estimates in `.0`, near ones in `.1`.
@@ -163,17 +176,17 @@ fn group_importance(ctx: &LightContext, g: &LightGroup) -> (Vec4, Vec4) {
     let r2 = dot3(half, half);
     let to_p = [0, 1, 2].map(|k| p[k] - pc[k]);
     let dist2 = dot3(to_p, to_p);
-    let outside = [0, 1, 2].map(|k| p[k] - p[k].max(lo[k]).min(hi[k]));
+    let outside = [0, 1, 2].map(|k| p[k] - min_ps(max_ps(p[k], lo[k]), hi[k]));
     let tiny = Vec4::splat(1e-20);
-    let d2_far = dist2.max(r2).max(tiny);
-    let d2_near = dot3(outside, outside).max(Vec4::splat(0.25) * r2).max(tiny);
+    let d2_far = max_ps(max_ps(dist2, r2), tiny);
+    let d2_near = max_ps(max_ps(dot3(outside, outside), Vec4::splat(0.25) * r2), tiny);
     let inside = dist2.cmple(r2);
     let inv_d = Vec4::ONE / dist2.sqrt();
     let wi = to_p.map(|c| c * inv_d);
     let mut cos_w = dot3(g.axis.map(Vec4::from), wi);
     let two_sided = g.next.map(|x| x & LIGHT_TWO_SIDED != 0);
     cos_w = Vec4::select(BVec4A::from_array(two_sided), cos_w.abs(), cos_w);
-    let safe_sqrt = |x: Vec4| x.max(zero).sqrt();
+    let safe_sqrt = |x: Vec4| max_ps(x, zero).sqrt();
     let cos_sub = |sa: Vec4, ca: Vec4, sb: Vec4, cb: Vec4| Vec4::select(ca.cmpgt(cb), Vec4::ONE, ca * cb + sa * sb);
     let sin_sub = |sa: Vec4, ca: Vec4, sb: Vec4, cb: Vec4| Vec4::select(ca.cmpgt(cb), zero, sa * cb - ca * sb);
     let sin_w = safe_sqrt(Vec4::ONE - cos_w * cos_w);
@@ -189,7 +202,7 @@ fn group_importance(ctx: &LightContext, g: &LightGroup) -> (Vec4, Vec4) {
     let sin_i = safe_sqrt(Vec4::ONE - cos_i * cos_i);
     let cos_pi = cos_sub(sin_i, cos_i, sin_b, cos_b);
     let lit = phi * cos_p * cos_pi;
-    let (mut far, mut near) = ((lit / d2_far).max(zero), (lit / d2_near).max(zero));
+    let (mut far, mut near) = (max_ps(lit / d2_far, zero), max_ps(lit / d2_near, zero));
     far = Vec4::select(culled, zero, far);
     near = Vec4::select(culled, zero, near);
     far = Vec4::select(inside, phi / d2_far, far);
