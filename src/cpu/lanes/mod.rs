@@ -11,6 +11,7 @@
 pub mod bsdf;
 pub mod lane;
 pub mod light_tree;
+pub mod lights;
 pub mod paths;
 pub mod sampler;
 

@@ -10,6 +10,7 @@
 use super::bsdf::{BaseLanes, base_eval, base_pdf, base_sample, is_plain};
 use super::lane::{F8, M8, U8, V3};
 use super::light_tree::sample_light_tree_lanes;
+use super::lights::sample_lights;
 use super::sampler::SamplerLanes;
 use super::{LANES, lanes_of};
 use crate::Strategy;
@@ -21,7 +22,7 @@ use crate::cpu::integrator::{
     path_surface, spawn_point,
 };
 use crate::cpu::light_tree::LightContext;
-use crate::cpu::lights::{LightSample, light_pdf, sample_light_chosen, tree_u};
+use crate::cpu::lights::{light_pdf, tree_u};
 use crate::cpu::material::shading_normal;
 use crate::packed::{Material, PackedScene, TRI_HAS_NORMALS, TRI_MIRRORED};
 use crate::params::Params;
@@ -342,45 +343,28 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
         }
         let contexts = std::array::from_fn(ctx);
         let walks = sample_light_tree_lanes(scene, params, &contexts, &u_tree, walking);
-        let mut ls = [LightSample {
-            wi: Vec3::Z,
-            dist: 0.0,
-            point: Vec3::ZERO,
-            normal: Vec3::Z,
-            radiance: Vec3::ZERO,
-            pdf: 0.0,
-            delta: false,
-        }; LANES];
-        for i in lanes_of(live.bits()) {
-            let uu = Vec3::new(u0.0[i], u1.0[i], u2.0[i]);
-            ls[i] = sample_light_chosen(scene, params, &contexts[i], uu, walks[i]);
-        }
-        let delta = M8(std::array::from_fn(|i| if ls[i].delta { u32::MAX } else { 0 }));
-        let connecting = live & (delta | M8::splat(strategy != Strategy::Bsdf));
+        let ls = sample_lights(scene, params, &contexts, (u0, u1, u2), &walks, live.bits());
+        let connecting = live & (ls.delta | M8::splat(strategy != Strategy::Bsdf));
         if connecting.bits() != 0 {
-            let wi = V3::from_fn(|i| ls[i].wi);
-            let wi_local = to_local(&frame, wi);
+            let wi_local = to_local(&frame, ls.wi);
             let f = base_eval(&base, wo, wi_local);
             let pdf_b = base_pdf(&base, wo, wi_local);
-            let light_pdf = F8::from_fn(|i| ls[i].pdf);
             let mut c = V3::splat(Vec3::ZERO);
             for i in lanes_of(connecting.bits()) {
-                if ls[i].pdf > 0.0 {
-                    c.set_lane(
-                        i,
-                        connect_evaluated(scene, point.lane(i), ng.lane(i), &ls[i], wi_local.lane(i), f.lane(i)),
-                    );
+                if ls.pdf.0[i] > 0.0 {
+                    let l = ls.lane(i);
+                    c.set_lane(i, connect_evaluated(scene, point.lane(i), ng.lane(i), &l, wi_local.lane(i), f.lane(i)));
                 }
             }
             let add = connecting & c.max_element().gt(zero);
             if add.bits() != 0 {
                 let w = F8::select(
-                    M8::splat(strategy == Strategy::Light) | delta,
+                    M8::splat(strategy == Strategy::Light) | ls.delta,
                     F8::splat(1.0),
-                    mis_weight(strategy, light_pdf, pdf_b),
+                    mis_weight(strategy, ls.pdf, pdf_b),
                 );
                 let depth1 = paths.depth.map(|d| d + 1);
-                let contribution = clamp_contribution(params, paths.beta * c * (w / light_pdf), depth1);
+                let contribution = clamp_contribution(params, paths.beta * c * (w / ls.pdf), depth1);
                 paths.radiance = V3::select(add, paths.radiance + contribution, paths.radiance);
             }
         }
