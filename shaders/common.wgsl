@@ -254,6 +254,12 @@ struct Params {
     projection: u32,
     // First record of the triangles' COLOR_0 and TEXCOORD_1 in the attributes (0: none).
     extras_base: u32,
+    // Light candidates resampled at a glossy vertex (light_candidates in integrator.wgsl);
+    // 1: one light sample, no resampling.
+    light_candidates: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 struct Ray {

@@ -69,7 +69,8 @@ struct PathState {
     beta: vec3<f32>,
     // Path segments so far (Mitsuba's depth): 1 after the camera ray's hit.
     depth: u32,
-    // The previous vertex's BSDF sample: its density and whether it was a Dirac one.
+    // The previous vertex's BSDF sample: its density (divided by candidate_pdf_scale where
+    // next-event estimation resampled several light candidates) and whether it was a Dirac one.
     prev_pdf: f32,
     prev_delta: bool,
     // The previous vertex as light selection saw it (for the tree's probability on a hit).
@@ -228,19 +229,123 @@ fn next_event_wanted() -> bool {
     return nee_lights > 0u || params.env_select > 0.0;
 }
 
-// Next-event estimation at the vertex: one light sample (and one of the separately sampled
-// punctual lights), each connected by a shadow ray and weighted by MIS.
+// Perceptual roughness below which a reflection lobe counts as glossy: narrow enough that a
+// light chosen without the BSDF rarely falls inside it (GGX alpha < 0.25).
+const GLOSSY_ROUGHNESS: f32 = 0.5;
+
+fn roughness_glossy(r: f32) -> bool {
+    return r < GLOSSY_ROUGHNESS && r * r >= DELTA_ALPHA;
+}
+
+// Has the material a glossy reflection lobe (a GGX lobe, not a Dirac one, in the base or the
+// coat)?
+fn material_glossy(m: Material) -> bool {
+    return roughness_glossy(m.roughness) || (m.clearcoat > 0.0 && roughness_glossy(m.clearcoat_roughness));
+}
+
+// Light candidates next-event estimation resamples at a vertex of material `m`: the
+// sampler's count at glossy surfaces, else 1 (one light sample, as the tree alone).
+fn light_candidates(m: Material) -> u32 {
+    if (params.light_candidates > 1u && params.strategy != STRATEGY_BSDF && material_glossy(m)) {
+        return params.light_candidates;
+    }
+    return 1u;
+}
+
+// MIS weighs `count` light candidates of density p against the BSDF's one sample as one
+// sample of density count * p (balance heuristic) or sqrt(count) * p (power heuristic, whose
+// weights go by squares); the BSDF's density divided by this factor keeps the two-strategy
+// weight.
+fn candidate_pdf_scale(strategy: u32, count: u32) -> f32 {
+    if (count <= 1u) {
+        return 1.0;
+    }
+    if (strategy == STRATEGY_MIS_BALANCE) {
+        return f32(count);
+    }
+    return sqrt(f32(count));
+}
+
+// Next-event estimation at the vertex: one light sample (or the one kept of several
+// candidates at a glossy surface, path_resample_lights), and one of the separately sampled
+// punctual lights, each connected by a shadow ray and weighted by MIS.
 fn path_next_event(path: ptr<function, PathState>, sampler: ptr<function, Sampler>, sv: SurfaceVertex) {
     if (next_event_wanted()) {
         let u_light = vec3<f32>(sample_1d(sampler), sample_2d(sampler));
         let ls = sample_light(sv.ctx, u_light);
-        path_connect_light(path, sv, ls);
+        let count = light_candidates(sv.mat);
+        if (count > 1u) {
+            path_resample_lights(path, sampler, sv, ls, count);
+        } else {
+            path_connect_light(path, sv, ls);
+        }
     }
     // Punctual lights outside the tree: only next-event estimation can reach them.
     if (PUNCTUAL_LIGHTS && params.separate_punctuals > 0u) {
         let ls = sample_punctual(sv.point, sample_1d(sampler));
         let c = (*path).beta * connect(sv.mat, sv.frame, sv.wo, sv.eta, sv.point, sv.ng, ls) / max(ls.pdf, 1e-30);
         (*path).radiance += clamp_contribution(c, (*path).depth + 1u);
+    }
+}
+
+// Resampled next-event estimation (RIS with MIS-weighted candidates): `count` light samples
+// (`first`, then more from the sampler), each weighed by its unshadowed contribution's
+// luminance (f |cos| L, the target) over its density, times its MIS weight among the
+// candidates and the BSDF sample; one is kept in proportion to its weight and connected by one
+// shadow ray, its contribution scaled by the weights' sum over its target. Unbiased: each
+// candidate contributes m f L V / p in expectation, and the `count` weights m and the BSDF
+// sample's (its density divided by candidate_pdf_scale) sum to 1.
+fn path_resample_lights(
+    path: ptr<function, PathState>, sampler: ptr<function, Sampler>, sv: SurfaceVertex, first: LightSample, count: u32
+) {
+    let strategy = params.strategy;
+    let scale = candidate_pdf_scale(strategy, count);
+    let share = 1.0 / f32(count);
+    var u_pick = sample_1d(sampler);
+    var w_sum = 0.0;
+    var kept = first;
+    var kept_c = vec3<f32>(0.0);
+    var kept_target = 0.0;
+    for (var k = 0u; k < count; k++) {
+        var ls = first;
+        if (k > 0u) {
+            let u_light = vec3<f32>(sample_1d(sampler), sample_2d(sampler));
+            ls = sample_light(sv.ctx, u_light);
+        }
+        if (ls.pdf <= 0.0 || !(ls.delta || strategy != STRATEGY_BSDF)) {
+            continue;
+        }
+        let wi_local = to_local(sv.frame, ls.wi);
+        if (!same_side(ls.wi, sv.ng, wi_local)) {
+            continue;
+        }
+        let c = bsdf_eval(sv.mat, sv.wo, wi_local, sv.eta) * abs(wi_local.z) * ls.radiance;
+        let target_value = luminance(c);
+        if (target_value <= 0.0) {
+            continue;
+        }
+        var mis = share;
+        if (strategy != STRATEGY_LIGHT && !ls.delta) {
+            mis = share * mis_weight(strategy, ls.pdf, bsdf_pdf(sv.mat, sv.wo, wi_local, sv.eta) / scale);
+        }
+        let w = mis * target_value / ls.pdf;
+        if (w <= 0.0) {
+            continue;
+        }
+        w_sum += w;
+        // One number picks among the candidates as they stream by, rescaled after each.
+        let p = w / w_sum;
+        if (u_pick < p) {
+            kept = ls;
+            kept_c = c;
+            kept_target = target_value;
+            u_pick = min(u_pick / p, ONE_MINUS_EPSILON);
+        } else {
+            u_pick = min((u_pick - p) / (1.0 - p), ONE_MINUS_EPSILON);
+        }
+    }
+    if (kept_target > 0.0 && unoccluded(spawn_point(sv.point, sv.ng, kept.wi), kept)) {
+        (*path).radiance += clamp_contribution((*path).beta * kept_c * (w_sum / kept_target), (*path).depth + 1u);
     }
 }
 
@@ -280,7 +385,9 @@ fn path_scatter(path: ptr<function, PathState>, sampler: ptr<function, Sampler>,
     if (max_component((*path).beta) <= 0.0) {
         return false;
     }
-    (*path).prev_pdf = bs.pdf;
+    // Against several light candidates MIS sees the BSDF's density scaled down.
+    let count = light_candidates(sv.mat);
+    (*path).prev_pdf = select(bs.pdf, bs.pdf / candidate_pdf_scale(params.strategy, count), count > 1u);
     (*path).prev_delta = bs.delta;
     (*path).prev_ctx = sv.ctx;
     (*path).ray = Ray(spawn_point(sv.point, sv.ng, wi), wi);

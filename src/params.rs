@@ -77,11 +77,20 @@ pub struct Params {
     pub projection: u32,
     /// First `attributes` record of the triangles' COLOR_0 and TEXCOORD_1 (0: none).
     pub extras_base: u32,
+    /// Light candidates resampled at a glossy vertex (`LightSampler::Ris`); 1: one light
+    /// sample, no resampling.
+    pub light_candidates: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 /// Camera projections (`Params::projection`; PROJECTION_* in shaders/common.wgsl).
 pub const PROJECTION_PERSPECTIVE: u32 = 0;
 pub const PROJECTION_ORTHOGRAPHIC: u32 = 1;
+
+/// Light candidates per glossy vertex with `LightSampler::Ris` (measured in BENCHMARKS.md).
+pub const RIS_CANDIDATES: u32 = 4;
 
 /// Russian roulette starts once a path has this many segments.
 pub const RR_DEPTH: u32 = 3;
@@ -108,7 +117,7 @@ impl Params {
     /// set up (a pinhole).
     pub fn new(camera: &Camera, settings: &Settings, tile: Tile, scene: &PackedScene) -> Params {
         let light_count = scene.lights.len() as u32;
-        let tree = settings.light_sampler == LightSampler::Tree && scene.tree_emitters > 0;
+        let tree = settings.light_sampler != LightSampler::Power && scene.tree_emitters > 0;
         let lights = if tree { scene.tree_emitters } else { light_count };
         let (w, h) = (settings.width, settings.height);
         let environment = scene.environment;
@@ -162,6 +171,10 @@ impl Params {
             },
             projection: if camera.ortho.is_some() { PROJECTION_ORTHOGRAPHIC } else { PROJECTION_PERSPECTIVE },
             extras_base: scene.extras_base,
+            light_candidates: if settings.light_sampler == LightSampler::Ris { RIS_CANDIDATES } else { 1 },
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         }
     }
 }

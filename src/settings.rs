@@ -69,15 +69,20 @@ pub enum LightSampler {
     /// The light BVH: emitters (triangles, point and spot lights) chosen by their importance
     /// to the shading point (distance, orientation, the surface's tangent plane).
     Tree = 1,
+    /// Resampled importance sampling over the tree: at glossy surfaces, `RIS_CANDIDATES` light
+    /// samples from the tree, one kept in proportion to its unshadowed contribution (BSDF and
+    /// cosine included) for a single shadow ray; elsewhere the tree's one sample.
+    Ris = 2,
 }
 
 impl LightSampler {
-    pub const ALL: [LightSampler; 2] = [LightSampler::Power, LightSampler::Tree];
+    pub const ALL: [LightSampler; 3] = [LightSampler::Power, LightSampler::Tree, LightSampler::Ris];
 
     pub fn label(self) -> &'static str {
         match self {
             LightSampler::Power => "power",
             LightSampler::Tree => "tree",
+            LightSampler::Ris => "ris",
         }
     }
 }

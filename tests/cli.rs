@@ -508,7 +508,7 @@ fn bench_report(with_gpu: bool) {
     assert!(tree["depth"].as_u64().is_some_and(|d| (7..=16).contains(&d)), "{tree}");
     for sc in scenes {
         // Each backend with each light sampler.
-        assert_eq!(sc["renders"].as_array().expect("renders").len(), if with_gpu { 4 } else { 2 });
+        assert_eq!(sc["renders"].as_array().expect("renders").len(), if with_gpu { 6 } else { 3 });
         assert!(sc["light_tree_emitters"].as_u64().is_some_and(|n| n > 0), "{sc}");
         let kinds = |key: &str| -> Vec<(String, f64)> {
             sc[key]

@@ -60,8 +60,8 @@ fn cases(engine: &str) -> Vec<(String, PathBuf, Settings)> {
     out
 }
 
-/// Hashes of the features scene's CPU films (power, tree).
-const FEATURES_CPU: [u64; 2] = [0x26c09aa96ba5529d, 0x1ff2ede67d6132a6];
+/// Hashes of the features scene's CPU films (power, tree, ris).
+const FEATURES_CPU: [u64; 3] = [0x26c09aa96ba5529d, 0x1ff2ede67d6132a6, 0xfdcf5573e4e12f78];
 
 /// GPU films hash the same only on the same driver: (driver string, hashes in `cases()` order).
 const GPU_FILMS: &[(&str, &[u64])] = &[(
@@ -77,6 +77,7 @@ const GPU_FILMS: &[(&str, &[u64])] = &[(
         0x1baecdc0f3f04fbe,
         0x0afb3282bdf07e7a,
         0xf73adfd2b25f1157,
+        0xcc0288ffe069078d,
     ],
 )];
 
@@ -105,8 +106,10 @@ fn cpu_films_of_bundled_scenes_are_unchanged() {
         return;
     }
     let mut wrong = Vec::new();
-    let expected = FILMS.iter().map(|f| f.4).chain(FEATURES_CPU);
-    for ((name, path, settings), expected) in cases("cpu").into_iter().zip(expected) {
+    let expected: Vec<u64> = FILMS.iter().map(|f| f.4).chain(FEATURES_CPU).collect();
+    let cases = cases("cpu");
+    assert_eq!(cases.len(), expected.len(), "a hash recorded for each case");
+    for ((name, path, settings), expected) in cases.into_iter().zip(expected) {
         let film = common::render(&path, &settings, 4, None);
         let h = fnv(&film.data);
         if h != expected {

@@ -122,7 +122,11 @@ fn shared_records_have_the_same_layout_in_rust_and_wgsl() {
                 sheen_base,
                 aov_base,
                 projection,
-                extras_base
+                extras_base,
+                light_candidates,
+                pad0,
+                pad1,
+                pad2
             }),
         ),
         ("Triangle", rust_layout!(Triangle { p0, material, e1, light_pdf_area, e2, flags })),
@@ -271,6 +275,7 @@ fn shared_constants_have_the_same_values() {
         ("PROJECTION_PERSPECTIVE", veach::params::PROJECTION_PERSPECTIVE as f64),
         ("PROJECTION_ORTHOGRAPHIC", veach::params::PROJECTION_ORTHOGRAPHIC as f64),
         ("LIGHT_SAMPLER_TREE", veach::LightSampler::Tree as u32 as f64),
+        ("GLOSSY_ROUGHNESS", veach::cpu::integrator::GLOSSY_ROUGHNESS as f64),
         ("MAT_ALPHA_MASK", p::MAT_ALPHA_MASK as f64),
         ("MAT_ALPHA_BLEND", p::MAT_ALPHA_BLEND as f64),
         ("MAT_DOUBLE_SIDED", p::MAT_DOUBLE_SIDED as f64),

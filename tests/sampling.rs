@@ -87,7 +87,9 @@ fn light_densities(scene: &PackedScene, params: &Params, ctx: &LightContext, wi:
 fn light_sampling_matches_its_pdf() {
     let free = |p: Vec3| LightContext { point: p, normal: Vec3::Z, reflect_only: false };
     let mut cases = Vec::new();
-    for sampler in LightSampler::ALL {
+    // (Resampling draws its candidates with the tree's `sample_light`; what it keeps has no
+    // density to test against: tests/light_resampling.rs checks it is unbiased.)
+    for sampler in [LightSampler::Power, LightSampler::Tree] {
         cases.push((sampler, false, free(Vec3::ZERO)));
         cases.push((sampler, true, free(Vec3::ZERO)));
         cases.push((sampler, true, free(Vec3::new(0.3, 0.4, -0.2))));

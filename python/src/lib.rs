@@ -338,7 +338,7 @@ fn render(
         settings.sampler = parse_name("sampler", n, "sobol or independent")?;
     }
     if let Some(n) = &light_sampler {
-        settings.light_sampler = parse_name("light sampler", n, "tree or power")?;
+        settings.light_sampler = parse_name("light sampler", n, "tree, ris or power")?;
     }
     for a in &aovs {
         settings.aovs.push(parse_name("AOV", a, "albedo, normal or depth")?);

@@ -1,11 +1,12 @@
 //! Twin of `shaders/integrator.wgsl`: the path tracer, sample for sample.
 
 use super::bsdf::{
-    BsdfSample, LobeChoice, bsdf_albedo, bsdf_eval, bsdf_is_delta, bsdf_pdf_chosen, bsdf_sample_chosen, lobe_choice,
+    BsdfSample, DELTA_ALPHA, LobeChoice, bsdf_albedo, bsdf_eval, bsdf_is_delta, bsdf_pdf_chosen, bsdf_sample_chosen,
+    lobe_choice,
 };
 use super::bvh::{Hit, NO_HIT, intersect_closest, occluded, offset_ray};
 use super::camera::camera_sample;
-use super::common::{INF, Ray};
+use super::common::{INF, ONE_MINUS_EPSILON, Ray, luminance};
 use super::environment::{environment_pdf, environment_radiance};
 use super::frame::{Frame, frame_from_normal, from_local, to_local};
 use super::instance::world_triangle;
@@ -112,7 +113,8 @@ pub struct PathState {
     pub beta: Vec3,
     /// Path segments so far (Mitsuba's depth): 1 after the camera ray's hit.
     pub depth: u32,
-    /// The previous vertex's BSDF sample: its density and whether it was a Dirac one.
+    /// The previous vertex's BSDF sample: its density (divided by `candidate_pdf_scale` where
+    /// next-event estimation resampled several light candidates) and whether it was a Dirac one.
     pub prev_pdf: f32,
     pub prev_delta: bool,
     /// The previous vertex as light selection saw it (for the tree's probability on a hit).
@@ -318,8 +320,46 @@ pub fn next_event_wanted(params: &Params) -> bool {
     }
 }
 
-/// Next-event estimation at the vertex: one light sample (and one of the separately sampled
-/// punctual lights), each connected by a shadow ray and weighted by MIS.
+/// Perceptual roughness below which a reflection lobe counts as glossy: narrow enough that a
+/// light chosen without the BSDF rarely falls inside it (GGX α < 0.25).
+pub const GLOSSY_ROUGHNESS: f32 = 0.5;
+
+/// Has the material a glossy reflection lobe (a GGX lobe, not a Dirac one, in the base or
+/// the coat)? A function of the material alone, so that the lanes kernel can tell too.
+#[inline(always)]
+pub fn material_glossy(m: &Material) -> bool {
+    let glossy = |r: f32| r < GLOSSY_ROUGHNESS && r * r >= DELTA_ALPHA;
+    glossy(m.roughness) || (m.clearcoat > 0.0 && glossy(m.clearcoat_roughness))
+}
+
+/// Light candidates next-event estimation resamples at a vertex of material `m`: the
+/// sampler's count at glossy surfaces, else 1 (one light sample, as the tree alone).
+#[inline(always)]
+pub fn light_candidates(params: &Params, m: &Material) -> u32 {
+    if params.light_candidates > 1 && path_strategy(params) != Strategy::Bsdf && material_glossy(m) {
+        params.light_candidates
+    } else {
+        1
+    }
+}
+
+/// MIS weighs `count` light candidates of density p against the BSDF's one sample as one
+/// sample of density count·p (balance heuristic) or √count·p (power heuristic, whose weights
+/// go by squares); the BSDF's density divided by this factor keeps the two-strategy weight.
+#[inline(always)]
+pub fn candidate_pdf_scale(strategy: Strategy, count: u32) -> f32 {
+    if count <= 1 {
+        1.0
+    } else if strategy == Strategy::MisBalance {
+        count as f32
+    } else {
+        (count as f32).sqrt()
+    }
+}
+
+/// Next-event estimation at the vertex: one light sample (or the one kept of several
+/// candidates at a glossy surface, `path_resample_lights`), and one of the separately sampled
+/// punctual lights, each connected by a shadow ray and weighted by MIS.
 #[inline(always)]
 pub fn path_next_event(scene: &PackedScene, params: &Params, path: &mut PathState, sv: &SurfaceVertex) {
     let strategy = path_strategy(params);
@@ -328,12 +368,87 @@ pub fn path_next_event(scene: &PackedScene, params: &Params, path: &mut PathStat
         let u0 = sample_1d(&mut path.sampler);
         let u12 = sample_2d(&mut path.sampler);
         let ls = sample_light(scene, params, &sv.ctx, Vec3::new(u0, u12.x, u12.y));
-        path_connect_light(scene, params, strategy, path, sv, &ls);
+        let count = light_candidates(params, m);
+        if count > 1 {
+            path_resample_lights(scene, params, strategy, path, sv, ls, count);
+        } else {
+            path_connect_light(scene, params, strategy, path, sv, &ls);
+        }
     }
     if params.separate_punctuals > 0 {
         let ls = sample_punctual(scene, params, sv.point, sample_1d(&mut path.sampler));
         let c = path.beta * connect(scene, m, &sv.frame, sv.wo, sv.eta, sv.point, sv.ng, &ls) / ls.pdf.max(1e-30);
         path.radiance += clamp_contribution(params, c, path.depth + 1);
+    }
+}
+
+/// Resampled next-event estimation (RIS with MIS-weighted candidates): `count` light samples
+/// (`first`, then more from the sampler), each weighed by its unshadowed contribution's
+/// luminance (f · |cos θ| · L, the target) over its density, times its MIS weight among the
+/// candidates and the BSDF sample; one is kept in proportion to its weight and connected by one
+/// shadow ray, its contribution scaled by the weights' sum over its target. Unbiased: each
+/// candidate contributes m · f · L · V / p in expectation, the `count` weights m and the BSDF
+/// sample's (its density divided by `candidate_pdf_scale`) sum to 1.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+pub fn path_resample_lights(
+    scene: &PackedScene,
+    params: &Params,
+    strategy: Strategy,
+    path: &mut PathState,
+    sv: &SurfaceVertex,
+    first: LightSample,
+    count: u32,
+) {
+    let m = &*sv.mat;
+    let scale = candidate_pdf_scale(strategy, count);
+    let share = 1.0 / count as f32;
+    let mut u_pick = sample_1d(&mut path.sampler);
+    let mut w_sum = 0.0;
+    let mut kept: Option<(LightSample, Vec3, f32)> = None;
+    for k in 0..count {
+        let ls = if k == 0 {
+            first
+        } else {
+            let u0 = sample_1d(&mut path.sampler);
+            let u12 = sample_2d(&mut path.sampler);
+            sample_light(scene, params, &sv.ctx, Vec3::new(u0, u12.x, u12.y))
+        };
+        if ls.pdf <= 0.0 || !(ls.delta || strategy != Strategy::Bsdf) {
+            continue;
+        }
+        let wi_local = to_local(&sv.frame, ls.wi);
+        if !same_side(ls.wi, sv.ng, wi_local) {
+            continue;
+        }
+        let c = bsdf_eval(m, sv.wo, wi_local, sv.eta) * wi_local.z.abs() * ls.radiance;
+        let target = luminance(c);
+        if target <= 0.0 {
+            continue;
+        }
+        let mis = if strategy == Strategy::Light || ls.delta {
+            share
+        } else {
+            share * mis_weight(strategy, ls.pdf, bsdf_pdf_chosen(m, &sv.lobes, sv.wo, wi_local, sv.eta) / scale)
+        };
+        let w = mis * target / ls.pdf;
+        if w <= 0.0 {
+            continue;
+        }
+        w_sum += w;
+        // One number picks among the candidates as they stream by, rescaled after each.
+        let p = w / w_sum;
+        if u_pick < p {
+            kept = Some((ls, c, target));
+            u_pick = (u_pick / p).min(ONE_MINUS_EPSILON);
+        } else {
+            u_pick = ((u_pick - p) / (1.0 - p)).min(ONE_MINUS_EPSILON);
+        }
+    }
+    if let Some((ls, c, target)) = kept
+        && unoccluded(scene, spawn_point(sv.point, sv.ng, ls.wi), &ls)
+    {
+        path.radiance += clamp_contribution(params, path.beta * c * (w_sum / target), path.depth + 1);
     }
 }
 
@@ -406,7 +521,9 @@ pub fn path_continue(params: &Params, path: &mut PathState, sv: &SurfaceVertex, 
     if path.beta.max_element() <= 0.0 {
         return false;
     }
-    path.prev_pdf = bs.pdf;
+    // Against several light candidates MIS sees the BSDF's density scaled down.
+    let count = light_candidates(params, &sv.mat);
+    path.prev_pdf = if count > 1 { bs.pdf / candidate_pdf_scale(path_strategy(params), count) } else { bs.pdf };
     path.prev_delta = bs.delta;
     path.prev_ctx = sv.ctx;
     path.ray = Ray { origin: spawn_point(sv.point, sv.ng, wi), dir: wi };

@@ -198,7 +198,7 @@ pub struct BenchArgs {
     /// Also write the results as JSON to this file.
     #[arg(long)]
     pub json: Option<PathBuf>,
-    /// Write the generated scenes (spheres-large.glb, many-lights.gltf) into this directory
+    /// Write the generated scenes (spheres-large.glb, many-lights.gltf, glossy-hall.gltf) into this directory
     /// and exit, to render them with `veach render`.
     #[arg(long)]
     pub write_scenes: Option<PathBuf>,
@@ -265,8 +265,8 @@ pub struct LookArgs {
     #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub focus_distance: Option<f32>,
     /// How next-event estimation picks a light: tree (the light BVH: by importance to the
-    /// shading point; the default) or power (by power alone, the former sampler, kept for
-    /// comparison).
+    /// shading point; the default), ris (the tree's candidates resampled by their unshadowed
+    /// contribution at glossy surfaces) or power (by power alone, kept for comparison).
     #[arg(long, value_enum)]
     pub light_sampler: Option<LightSampler>,
 }

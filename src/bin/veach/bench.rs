@@ -15,7 +15,8 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
             &dir.join("many-lights.gltf"),
             &veach::bench::many_lights_gltf(veach::bench::MANY_LIGHTS),
         )?;
-        eprintln!("veach bench: wrote spheres-large.glb and many-lights.gltf to {}", dir.display());
+        veach::output::write_atomic(&dir.join("glossy-hall.gltf"), &veach::bench::glossy_hall_gltf())?;
+        eprintln!("veach bench: wrote spheres-large.glb, many-lights.gltf and glossy-hall.gltf to {}", dir.display());
         return Ok(());
     }
     let backends = if args.backend.is_empty() { vec![Backend::Gpu, Backend::Cpu] } else { args.backend.clone() };

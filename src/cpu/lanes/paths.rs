@@ -18,8 +18,8 @@ use crate::aov::AovSample;
 use crate::cpu::bvh::{Hit, NO_HIT, intersect_closest};
 use crate::cpu::common::{INF, Ray};
 use crate::cpu::integrator::{
-    PathState, connect_evaluated, next_event_wanted, path_escaped, path_next_event, path_scatter, path_strategy,
-    path_surface, spawn_point,
+    PathState, connect_evaluated, light_candidates, next_event_wanted, path_escaped, path_next_event, path_scatter,
+    path_strategy, path_surface, spawn_point,
 };
 use crate::cpu::light_tree::LightContext;
 use crate::cpu::lights::{light_pdf, tree_u};
@@ -140,6 +140,8 @@ fn plain_material(scene: &PackedScene, params: &Params, m: &Material, index: usi
         && !scene.material_textured[index]
         && is_plain(m)
         && Vec3::from(m.attenuation).max_element() <= 0.0
+        // Resampled light candidates (glossy surfaces with `LightSampler::Ris`) run per lane.
+        && light_candidates(params, m) == 1
 }
 
 #[inline(always)]

@@ -12,8 +12,11 @@ use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
 
-pub const CORNELL_BOX: &[u8] = include_bytes!("../assets/cornell-box.gltf");
-pub const VEACH_MIS: &[u8] = include_bytes!("../assets/veach-mis.gltf");
+mod scenes;
+pub use scenes::{glossy_hall_gltf, many_lights_gltf};
+
+pub const CORNELL_BOX: &[u8] = include_bytes!("../../assets/cornell-box.gltf");
+pub const VEACH_MIS: &[u8] = include_bytes!("../../assets/veach-mis.gltf");
 /// Lamps of the generated many-light scene.
 pub const MANY_LIGHTS: u32 = 300;
 
@@ -547,88 +550,4 @@ pub fn format_report(r: &BenchReport) -> String {
         "generated", t.emitters, t.nodes, t.depth, t.build_seconds, t.bytes_per_emitter
     );
     s
-}
-
-/// A many-light scene: a 40 × 40 floor under `lamps` small square lamps (4 × 4 grids, 32
-/// triangles each) at heights 1–2.5, of radiance spanning two decades, facing down or
-/// sideways, seen from above (the camera frames the middle 9 × 9). The same construction
-/// as the many-light test (tests/light_tree.rs). A .gltf with an embedded buffer.
-pub fn many_lights_gltf(lamps: u32) -> Vec<u8> {
-    use base64::Engine;
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut f = move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (state >> 40) as f32 / (1u64 << 24) as f32
-    };
-    let mut positions: Vec<Vec3> = vec![
-        Vec3::new(-20.0, -20.0, 0.0),
-        Vec3::new(20.0, -20.0, 0.0),
-        Vec3::new(20.0, 20.0, 0.0),
-        Vec3::new(-20.0, 20.0, 0.0),
-    ];
-    let mut indices: Vec<u32> = vec![0, 1, 2, 0, 2, 3];
-    let mut primitives = vec![serde_json::json!({"attributes": {"POSITION": 0}, "indices": 1, "material": 0})];
-    let mut materials = vec![serde_json::json!({"name": "floor",
-        "pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1.0], "metallicFactor": 0.0}})];
-    let mut index_ranges = vec![(0usize, 6usize)];
-    let n = 4;
-    for k in 0..lamps {
-        let strength = 0.2 * 10f32.powf(2.0 * f());
-        let color = [0.5 + 0.5 * f(), 0.5 + 0.5 * f(), 0.5 + 0.5 * f()];
-        let axis = if k % 3 == 0 {
-            Vec3::new(f() - 0.5, f() - 0.5, -0.05 - 0.5 * f()).normalize()
-        } else {
-            Vec3::new(0.4 * (f() - 0.5), 0.4 * (f() - 0.5), -1.0).normalize()
-        };
-        let q = glam::Quat::from_rotation_arc(Vec3::Z, axis);
-        let t = Vec3::new(40.0 * (f() - 0.5), 40.0 * (f() - 0.5), 1.0 + 1.5 * f());
-        let base = positions.len() as u32;
-        for j in 0..=n {
-            for i in 0..=n {
-                let local = Vec3::new(-0.08 + 0.16 * i as f32 / n as f32, -0.08 + 0.16 * j as f32 / n as f32, 0.0);
-                positions.push(t + q * local);
-            }
-        }
-        let start = indices.len();
-        let w = n + 1;
-        for j in 0..n {
-            for i in 0..n {
-                let a = base + j * w + i;
-                indices.extend([a, a + 1, a + w + 1, a, a + w + 1, a + w]);
-            }
-        }
-        index_ranges.push((start, indices.len() - start));
-        materials.push(serde_json::json!({"name": format!("lamp{k}"), "emissiveFactor": color,
-            "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": strength}},
-            "pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0]}}));
-        primitives.push(serde_json::json!({"attributes": {"POSITION": 0}, "indices": k + 2, "material": k + 1}));
-    }
-    let mut bin: Vec<u8> = positions.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect();
-    let index_offset = bin.len();
-    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
-    let min = positions.iter().fold(Vec3::INFINITY, |a, &p| a.min(p));
-    let max = positions.iter().fold(Vec3::NEG_INFINITY, |a, &p| a.max(p));
-    let mut accessors = vec![serde_json::json!({"bufferView": 0, "componentType": 5126, "count": positions.len(),
-        "type": "VEC3", "min": min.to_array(), "max": max.to_array()})];
-    for (start, count) in index_ranges {
-        accessors.push(serde_json::json!({"bufferView": 1, "byteOffset": 4 * start, "componentType": 5125,
-            "count": count, "type": "SCALAR"}));
-    }
-    let uri =
-        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
-    let doc = serde_json::json!({
-        "asset": {"version": "2.0", "generator": "veach bench"},
-        "extensionsUsed": ["KHR_materials_emissive_strength"],
-        "scene": 0,
-        "scenes": [{"nodes": [0, 1]}],
-        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0.0, 0.0, 7.0]}],
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 1.1, "aspectRatio": 1.0, "znear": 0.01}}],
-        "meshes": [{"primitives": primitives}],
-        "materials": materials,
-        "accessors": accessors,
-        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": index_offset},
-            {"buffer": 0, "byteOffset": index_offset, "byteLength": bin.len() - index_offset}],
-        "buffers": [{"byteLength": bin.len(), "uri": uri}],
-    });
-    serde_json::to_vec_pretty(&doc).expect("json")
 }
