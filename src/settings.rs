@@ -69,9 +69,10 @@ pub enum LightSampler {
     /// The light BVH: emitters (triangles, point and spot lights) chosen by their importance
     /// to the shading point (distance, orientation, the surface's tangent plane).
     Tree = 1,
-    /// Resampled importance sampling over the tree: at glossy surfaces, `RIS_CANDIDATES` light
-    /// samples from the tree, one kept in proportion to its unshadowed contribution (BSDF and
-    /// cosine included) for a single shadow ray; elsewhere the tree's one sample.
+    /// Resampled importance sampling over the tree (the default of `Settings`): at glossy
+    /// surfaces, `RIS_CANDIDATES` light samples from the tree, one kept in proportion to its
+    /// unshadowed contribution (BSDF and cosine included) for a single shadow ray; elsewhere
+    /// the tree's one sample. Best at equal time on every scene measured (BENCHMARKS.md).
     Ris = 2,
 }
 
@@ -250,7 +251,7 @@ impl Default for Settings {
             aperture: 0.0,
             focus_distance: None,
             sampler: SamplerKind::Sobol,
-            light_sampler: LightSampler::Tree,
+            light_sampler: LightSampler::Ris,
             clamp_direct: None,
             clamp_indirect: None,
             noise_threshold: None,

@@ -636,3 +636,56 @@ fn texture_memory_is_reported() {
     assert!(text.contains("texture atlas: 1 page(s) of 256²"), "{text}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `--light-sampler ris` is part of the render: `--stats-json` shows it, the EXR keeps it (a
+/// resumed render goes on with it), and merge refuses a part rendered with the tree.
+#[test]
+fn the_resampling_light_sampler_is_saved_resumed_and_checked_by_merge() {
+    let d = temp_dir("ris");
+    let veach_scene = common::asset("veach-mis.gltf");
+    let (a, b, resumed, stats) = (d.join("a.exr"), d.join("b.exr"), d.join("r.exr"), d.join("stats.json"));
+    let stats_s = stats.to_str().unwrap();
+    // A time-budgeted render (stopped early), then resumed for more samples.
+    let mut args = render_args(&veach_scene, &resumed, "16", "1000000");
+    args.extend(["--light-sampler", "ris", "--time", "0.3", "--backend", "cpu", "--stats-json", stats_s]);
+    let r = veach(&args, &[]);
+    assert_eq!(r.status.code(), Some(0), "{}", String::from_utf8_lossy(&r.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!(s["light_sampler"], "ris", "{s}");
+    let (film, job) = veach::output::read_film(&resumed).expect("a valid EXR");
+    assert_eq!(job.settings.light_sampler, veach::LightSampler::Ris);
+    let before = film.samples();
+    let r = veach(
+        &[
+            "render",
+            "--resume",
+            resumed.to_str().unwrap(),
+            "-o",
+            resumed.to_str().unwrap(),
+            "--time",
+            "0.2",
+            "--backend",
+            "cpu",
+        ],
+        &[],
+    );
+    assert_eq!(r.status.code(), Some(0), "{}", String::from_utf8_lossy(&r.stderr));
+    let (film, job) = veach::output::read_film(&resumed).expect("a valid EXR");
+    assert!(film.samples() > before, "{} after {before}", film.samples());
+    assert_eq!(job.settings.light_sampler, veach::LightSampler::Ris);
+
+    // Parts of one render must agree on the light sampler.
+    let mut args = render_args(&veach_scene, &a, "16", "8");
+    args.extend(["--light-sampler", "ris", "--sample-range", "0..4", "--backend", "cpu"]);
+    assert_eq!(veach(&args, &[]).status.code(), Some(0));
+    let mut args = render_args(&veach_scene, &b, "16", "8");
+    args.extend(["--light-sampler", "tree", "--sample-range", "4..8", "--backend", "cpu"]);
+    assert_eq!(veach(&args, &[]).status.code(), Some(0));
+    let merged = d.join("merged.exr");
+    assert_user_error(
+        &veach(&["merge", a.to_str().unwrap(), b.to_str().unwrap(), "-o", merged.to_str().unwrap()], &[]),
+        "light sampler",
+    );
+    assert!(!merged.exists());
+    let _ = std::fs::remove_dir_all(&d);
+}

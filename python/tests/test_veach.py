@@ -103,7 +103,7 @@ def test_stats_repr_png_and_save(tmp_path):
     image = small()
     stats = image.stats
     assert stats["spp"] == 4 and stats["width"] == 32 and stats["backend"] == "cpu"
-    assert stats["light_sampler"] == "tree" and stats["stopped_by"] == "samples"
+    assert stats["light_sampler"] == "ris" and stats["stopped_by"] == "samples"
     assert stats["samples_per_second"] > 0
     png = image._repr_png_()
     assert png.startswith(b"\x89PNG\r\n\x1a\n")

@@ -121,8 +121,8 @@ def render(
 
     - ``time``: stop after this many seconds of rendering (``spp`` is then a cap).
     - ``noise_threshold``: adaptive sampling (pixels stop once their error is below it).
-    - ``light_sampler``: "tree" (the default), "ris" (the tree's candidates resampled by their
-      unshadowed contribution at glossy surfaces) or "power".
+    - ``light_sampler``: "ris" (the default: the light tree's candidates resampled by their
+      unshadowed contribution at glossy surfaces), "tree" or "power".
     - ``aovs``: any of "albedo", "normal", "depth" (``Image.aov(name)``).
     - ``denoise``: run Open Image Denoise's network; ``Image.rgb`` is then the denoised image.
     - ``env``: a .hdr/.exr path, a grey level or (r, g, b) replacing the scene's environment.

@@ -264,9 +264,9 @@ pub struct LookArgs {
     /// Distance in focus (default with --aperture: what the image centre sees).
     #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub focus_distance: Option<f32>,
-    /// How next-event estimation picks a light: tree (the light BVH: by importance to the
-    /// shading point; the default), ris (the tree's candidates resampled by their unshadowed
-    /// contribution at glossy surfaces) or power (by power alone, kept for comparison).
+    /// How next-event estimation picks a light: ris (the default: at glossy surfaces four
+    /// candidates from the light tree, one kept by its unshadowed contribution), tree (the light
+    /// BVH alone: by importance to the shading point) or power (by power alone, for comparison).
     #[arg(long, value_enum)]
     pub light_sampler: Option<LightSampler>,
 }
