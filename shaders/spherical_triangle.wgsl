@@ -56,12 +56,9 @@ fn bounded_cos(x: f32) -> f32 {
     return bounded_sin(select(y, y - 2.0 * PI, y > PI));
 }
 
-// The angle between unit vectors, accurate near 0 and π.
+// The angle between unit vectors, 2·atan(|a − b| / |a + b|): accurate near 0 and π.
 fn angle_between(a: vec3<f32>, b: vec3<f32>) -> f32 {
-    if (dot(a, b) < 0.0) {
-        return PI - 2.0 * asin(min(length(a + b) * 0.5, 1.0));
-    }
-    return 2.0 * asin(min(length(b - a) * 0.5, 1.0));
+    return 2.0 * atan2(length(a - b), length(a + b));
 }
 
 fn orthonormal_part(v: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
@@ -82,19 +79,16 @@ fn sample_spherical_triangle(
     let a = normalize_or_zero(v0 - p);
     let b = normalize_or_zero(v1 - p);
     let c = normalize_or_zero(v2 - p);
-    var n_ab = cross(a, b);
-    var n_bc = cross(b, c);
-    var n_ca = cross(c, a);
+    let n_ab = cross(a, b);
+    let n_bc = cross(b, c);
+    let n_ca = cross(c, a);
     if (dot(n_ab, n_ab) == 0.0 || dot(n_bc, n_bc) == 0.0 || dot(n_ca, n_ca) == 0.0) {
         return fail;
     }
-    n_ab = normalize(n_ab);
-    n_bc = normalize(n_bc);
-    n_ca = normalize(n_ca);
-    let alpha = angle_between(n_ab, -n_ca);
-    let beta = angle_between(n_bc, -n_ab);
-    let gamma = angle_between(n_ca, -n_bc);
-    let area = alpha + beta + gamma - PI;
+    // The angle at a; the area by van Oosterom–Strackee, as the pdf and the inversion
+    // compute it (the angle sum α + β + γ − π loses small triangles in f32).
+    let alpha = angle_between(normalize(n_ab), -normalize(n_ca));
+    let area = unit_triangle_area(a, b, c);
     if (!(area > 0.0)) {
         return fail;
     }

@@ -27,14 +27,14 @@ fn fnv(words: &[u32]) -> u64 {
 /// (scene, max depth, sampler, light sampler, expected hash of a 48×48 film of 4 samples,
 /// seed 7). The power rows are the films from before the light tree existed.
 const FILMS: &[(&str, u32, veach::SamplerKind, veach::LightSampler, u64)] = &[
-    ("cornell-box.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0xe1da898f5d51b302),
-    ("cornell-box.gltf", 8, veach::SamplerKind::Independent, veach::LightSampler::Power, 0x114b9e2aa4a45558),
-    ("cornell-glass.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0xc0acbc95243005ef),
-    ("veach-mis.gltf", 2, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0x306c85d221bc9d9b),
-    ("furnace-a080.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0x4020415887b55e33),
-    ("furnace-a100.gltf", 8, veach::SamplerKind::Independent, veach::LightSampler::Power, 0xdcf88cd2ca2f48b4),
-    ("cornell-box.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Tree, 0x5f2d1f936920c9d2),
-    ("veach-mis.gltf", 2, veach::SamplerKind::Sobol, veach::LightSampler::Tree, 0xf7aac65677aa3d0a),
+    ("cornell-box.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0xd43c6ee7ae857498),
+    ("cornell-box.gltf", 8, veach::SamplerKind::Independent, veach::LightSampler::Power, 0xc926ec26b943c5f6),
+    ("cornell-glass.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0x08a584cc37bf3d7f),
+    ("veach-mis.gltf", 2, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0x63ad93f527974cb0),
+    ("furnace-a080.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Power, 0x3f62ef321f9cc55f),
+    ("furnace-a100.gltf", 8, veach::SamplerKind::Independent, veach::LightSampler::Power, 0xa56d194a8e1ba903),
+    ("cornell-box.gltf", 8, veach::SamplerKind::Sobol, veach::LightSampler::Tree, 0xc038d847fda7cb6a),
+    ("veach-mis.gltf", 2, veach::SamplerKind::Sobol, veach::LightSampler::Tree, 0x74d2196a05863d6e),
 ];
 
 /// The films this test renders: (name, scene file, settings).
@@ -61,7 +61,7 @@ fn cases(engine: &str) -> Vec<(String, PathBuf, Settings)> {
 }
 
 /// Hashes of the features scene's CPU films (power, tree, ris).
-const FEATURES_CPU: [u64; 3] = [0x26c09aa96ba5529d, 0x1ff2ede67d6132a6, 0xfdcf5573e4e12f78];
+const FEATURES_CPU: [u64; 3] = [0x747e5c845f5e7741, 0xe377171a912c97b1, 0x0100b9ce81713f20];
 
 /// GPU films hash the same only on the same driver: (driver string, hashes in `cases()` order).
 const GPU_FILMS: &[(&str, &[u64])] = &[(
@@ -73,11 +73,11 @@ const GPU_FILMS: &[(&str, &[u64])] = &[(
         0xa6a69cfc23b5ecae,
         0xcfe66b0f18714efc,
         0xbf1bac27a228f548,
-        0x5513a29fb8cd6301,
+        0xc069111180cae247,
         0x1baecdc0f3f04fbe,
         0x0afb3282bdf07e7a,
-        0xf73adfd2b25f1157,
-        0xcc0288ffe069078d,
+        0x5065bbe0ae70387f,
+        0xaabefb69ddffcf99,
     ],
 )];
 

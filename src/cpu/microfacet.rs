@@ -1,6 +1,7 @@
 //! Twin of `shaders/microfacet.wgsl`: GGX with height-correlated Smith masking and VNDF sampling.
 
 use super::common::INF;
+use super::trig::turn;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -39,10 +40,10 @@ pub fn ggx_sample_vndf(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
     let t1 = if len2 > 0.0 { Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt() } else { Vec3::X };
     let t2 = vh.cross(t1);
     let r = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
-    let p1 = r * phi.cos();
+    let (cos_phi, sin_phi) = turn(u.y);
+    let p1 = r * cos_phi;
     let s = 0.5 * (1.0 + vh.z);
-    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin_phi;
     let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
     Vec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(1e-7)).normalize()
 }
@@ -84,10 +85,10 @@ pub fn ggx_sample_vndf_aniso(wo: Vec3, ax: f32, ay: f32, u: Vec2) -> Vec3 {
     let t1 = if len2 > 0.0 { Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt() } else { Vec3::X };
     let t2 = vh.cross(t1);
     let r = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
-    let p1 = r * phi.cos();
+    let (cos_phi, sin_phi) = turn(u.y);
+    let p1 = r * cos_phi;
     let s = 0.5 * (1.0 + vh.z);
-    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin_phi;
     let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
     Vec3::new(ax * nh.x, ay * nh.y, nh.z.max(1e-7)).normalize()
 }

@@ -25,6 +25,7 @@ pub mod sampler;
 pub mod sampling;
 pub mod spherical_triangle;
 pub mod texture;
+pub mod trig;
 
 pub use integrator::render_sample;
 pub use renderer::{Kernel, Renderer};

@@ -1,13 +1,14 @@
 //! Twin of `shaders/sampling.wgsl`.
 
 use super::common::ONE_MINUS_EPSILON;
+use super::trig::turn;
 use glam::{Vec2, Vec3};
-use std::f32::consts::{FRAC_1_PI, PI};
+use std::f32::consts::FRAC_1_PI;
 
 pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
     let r = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt())
+    let (cos_phi, sin_phi) = turn(u.y);
+    Vec3::new(r * cos_phi, r * sin_phi, (1.0 - u.x).max(0.0).sqrt())
 }
 
 pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
@@ -17,8 +18,8 @@ pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
 pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (cos_phi, sin_phi) = turn(u.y);
+    Vec3::new(r * cos_phi, r * sin_phi, z)
 }
 
 pub const UNIFORM_SPHERE_PDF: f32 = 0.079_577_47;
@@ -26,8 +27,8 @@ pub const UNIFORM_SPHERE_PDF: f32 = 0.079_577_47;
 pub fn sample_uniform_hemisphere(u: Vec2) -> Vec3 {
     let z = u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (cos_phi, sin_phi) = turn(u.y);
+    Vec3::new(r * cos_phi, r * sin_phi, z)
 }
 
 /// 1 / 2π.
@@ -35,8 +36,8 @@ pub const UNIFORM_HEMISPHERE_PDF: f32 = 0.159_154_94;
 
 pub fn sample_uniform_disk(u: Vec2) -> Vec2 {
     let r = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec2::new(r * phi.cos(), r * phi.sin())
+    let (cos_phi, sin_phi) = turn(u.y);
+    Vec2::new(r * cos_phi, r * sin_phi)
 }
 
 pub fn sample_uniform_triangle(u: Vec2) -> Vec2 {

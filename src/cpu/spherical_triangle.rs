@@ -7,6 +7,7 @@
 //! first warped towards the receiver's cosine (`lights::receiver_cosine_weights`), and a BSDF
 //! hit reads that warp's density through `invert_spherical_triangle_sample`.
 
+use super::trig::{atan2, bounded_cos, bounded_sin};
 use glam::{Vec2, Vec3};
 
 /// Below 0.02 sr (a right triangle of area 0.5 seen from 5 units away) the inverse-square and
@@ -31,43 +32,9 @@ pub fn spherical_triangle_area(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> f32 {
     unit_triangle_area((v0 - p).normalize_or_zero(), (v1 - p).normalize_or_zero(), (v2 - p).normalize_or_zero())
 }
 
-/// sin x for |x| ≤ π by a polynomial of our own (Taylor to x¹³ on [−π/2, π/2], error below
-/// 1e-9 before rounding), the same operations in both twins: WGSL bounds its own sin and cos
-/// only to 2⁻¹¹ absolute, and lavapipe's differ from libm's enough to move samples.
-pub fn bounded_sin(x: f32) -> f32 {
-    let half_pi = std::f32::consts::FRAC_PI_2;
-    let pi = std::f32::consts::PI;
-    let y = if x > half_pi {
-        pi - x
-    } else if x < -half_pi {
-        -pi - x
-    } else {
-        x
-    };
-    let y2 = y * y;
-    let p = 1.0 / 6227020800.0;
-    let p = -1.0 / 39916800.0 + y2 * p;
-    let p = 1.0 / 362880.0 + y2 * p;
-    let p = -1.0 / 5040.0 + y2 * p;
-    let p = 1.0 / 120.0 + y2 * p;
-    let p = -1.0 / 6.0 + y2 * p;
-    y * (1.0 + y2 * p)
-}
-
-/// cos x for |x| ≤ π, as sin(x + π/2) brought back into [−π, π].
-pub fn bounded_cos(x: f32) -> f32 {
-    let pi = std::f32::consts::PI;
-    let y = x + std::f32::consts::FRAC_PI_2;
-    bounded_sin(if y > pi { y - 2.0 * pi } else { y })
-}
-
-/// The angle between unit vectors, accurate near 0 and π.
+/// The angle between unit vectors, 2·atan(|a − b| / |a + b|): accurate near 0 and π.
 fn angle_between(a: Vec3, b: Vec3) -> f32 {
-    if a.dot(b) < 0.0 {
-        std::f32::consts::PI - 2.0 * ((a + b).length() * 0.5).min(1.0).asin()
-    } else {
-        2.0 * ((b - a).length() * 0.5).min(1.0).asin()
-    }
+    2.0 * atan2((a - b).length(), (a + b).length())
 }
 
 /// `v` made orthogonal to unit `w`, normalised.
@@ -85,11 +52,11 @@ pub fn sample_spherical_triangle(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3, u0: f32,
     if n_ab.length_squared() == 0.0 || n_bc.length_squared() == 0.0 || n_ca.length_squared() == 0.0 {
         return None;
     }
-    let (n_ab, n_bc, n_ca) = (n_ab.normalize(), n_bc.normalize(), n_ca.normalize());
+    let (n_ab, n_ca) = (n_ab.normalize(), n_ca.normalize());
+    // The angle at a; the area by van Oosterom–Strackee (as `spherical_triangle_area` and the
+    // inversion compute it: the angle sum α + β + γ − π loses small triangles in f32).
     let alpha = angle_between(n_ab, -n_ca);
-    let beta = angle_between(n_bc, -n_ab);
-    let gamma = angle_between(n_ca, -n_bc);
-    let area = alpha + beta + gamma - std::f32::consts::PI;
+    let area = unit_triangle_area(a, b, c);
     if area.is_nan() || area <= 0.0 {
         return None;
     }
@@ -143,5 +110,5 @@ pub fn invert_spherical_triangle_sample(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3, w
 
 /// The solid angle of the spherical triangle of unit vectors a, b, c.
 fn unit_triangle_area(a: Vec3, b: Vec3, c: Vec3) -> f32 {
-    (2.0 * a.dot(b.cross(c)).atan2(1.0 + a.dot(b) + a.dot(c) + b.dot(c))).abs()
+    (2.0 * atan2(a.dot(b.cross(c)), 1.0 + a.dot(b) + a.dot(c) + b.dot(c))).abs()
 }

@@ -7,6 +7,7 @@
 //! other materials take the scalar functions (`super::trace_paths`).
 
 use super::lane::{F8, M8, V3};
+use super::trig::turn;
 use crate::cpu::bsdf::has_layers;
 use crate::cpu::common::INF;
 use crate::cpu::microfacet::DELTA_ALPHA;
@@ -125,19 +126,6 @@ pub fn ggx_reflection_pdf(wo: V3, h: V3, alpha: F8) -> F8 {
     ggx_g1(wo, alpha) * ggx_d(h, alpha) / (4.0 * wo.z)
 }
 
-/// cos and sin of φ = 2π u in the lanes of `mask`, by the platform's libm as the scalar code
-/// calls it (0 elsewhere): both samplers below turn by the same φ, so a lane pays once.
-#[inline(always)]
-pub fn turn(u: F8, mask: u32) -> (F8, F8) {
-    let phi = 2.0 * PI * u;
-    let (mut c, mut s) = ([0.0f32; super::LANES], [0.0f32; super::LANES]);
-    for i in super::lanes_of(mask) {
-        c[i] = phi.0[i].cos();
-        s[i] = phi.0[i].sin();
-    }
-    (F8(c), F8(s))
-}
-
 /// `ggx_sample_vndf` with cos φ and sin φ of φ = 2π u2 given (`turn`).
 #[inline(always)]
 pub fn ggx_sample_vndf(wo: V3, alpha: F8, u1: F8, (cos_phi, sin_phi): (F8, F8)) -> V3 {
@@ -203,16 +191,16 @@ pub struct SampleLanes {
     pub delta: M8,
 }
 
-/// `base_sample_chosen` of a plain material in the lanes of `mask`.
+/// `base_sample_chosen` of a plain material.
 #[inline(always)]
-pub fn base_sample(m: &BaseLanes, wo: V3, u: V3, mask: u32) -> SampleLanes {
+pub fn base_sample(m: &BaseLanes, wo: V3, u: V3) -> SampleLanes {
     let zero = F8::splat(0.0);
     let one = F8::splat(1.0);
     let [px, py, _, pw] = m.p;
     let alpha = m.roughness * m.roughness;
     let rough = alpha.ge(F8::splat(DELTA_ALPHA));
     // The specular lobe: a mirror, or a visible normal and its reflection.
-    let turn = turn(u.z, mask);
+    let turn = turn(u.z);
     let h = ggx_sample_vndf(wo, alpha, u.y, turn);
     let reflected = 2.0 * wo.dot(h) * h - wo;
     // The diffuse lobe, and (probability 0 here) its mirror image below.

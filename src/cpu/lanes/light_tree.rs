@@ -107,7 +107,8 @@ fn group_shares_lanes(c: &Contexts, g: &LightGroup) -> ([F8; WIDTH], M8) {
     let total_near = near[0] + near[1] + near[2] + near[3];
     // NaN or ≤ 0: a dead end.
     let end = !total_far.gt(zero);
-    let shares = std::array::from_fn(|k| 0.5 * (far[k] / total_far + near[k] / total_near));
+    let share = |k: usize| 0.5 * (far[k] / total_far + near[k] / total_near);
+    let shares = [share(0), share(1), share(2), share(3)];
     (shares, end)
 }
 

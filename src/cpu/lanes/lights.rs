@@ -1,11 +1,12 @@
 //! `sample_light_chosen` in lanes for the common case: an emissive triangle without an
 //! emission texture, chosen by the light tree (walks already taken) or the power sampler,
 //! then sampled in the solid angle it subtends (`spherical_triangle.rs`, with the receiver
-//! cosine warp) or by area — every operation the scalar one lane by lane, libm's asin and
-//! atan2 called per lane as the scalar code calls them. Lanes that pick the environment or a
+//! cosine warp) or by area — every operation the scalar one lane by lane, the arc tangent,
+//! sine and cosine the polynomials of `cpu::trig` in lanes. Lanes that pick the environment or a
 //! punctual light, or whose selection has no probability, take the scalar function.
 
 use super::lane::{F8, M8, V3};
+use super::trig::{atan2, bounded_cos, bounded_sin};
 use super::{LANES, lanes_of};
 use crate::cpu::common::{INF, ONE_MINUS_EPSILON};
 use crate::cpu::light_tree::LightContext;
@@ -14,7 +15,6 @@ use crate::cpu::spherical_triangle::{SOLID_ANGLE_MAX, SOLID_ANGLE_MIN};
 use crate::packed::{NO_TEXTURE, PackedScene};
 use crate::params::{LIGHT_SAMPLER_TREE, Params};
 use glam::Vec3;
-use std::f32::consts::{FRAC_PI_2, PI};
 
 /// Light samples in lanes (`LightSample`'s fields).
 #[derive(Clone, Copy, Debug)]
@@ -58,50 +58,15 @@ impl LightSampleLanes {
 #[inline(always)]
 fn normalize_or_zero(v: V3) -> V3 {
     let rcp = 1.0 / v.dot(v).sqrt();
-    let ok = M8(std::array::from_fn(|i| if rcp.0[i].is_finite() && rcp.0[i] > 0.0 { u32::MAX } else { 0 }));
+    // Finite and positive (NaN fails both).
+    let ok = rcp.gt(F8::splat(0.0)) & rcp.lt(F8::splat(f32::INFINITY));
     V3::select(ok, v * rcp, V3::splat(Vec3::ZERO))
-}
-
-/// `bounded_sin` in lanes (a polynomial: the same operations).
-#[inline(always)]
-fn bounded_sin(x: F8) -> F8 {
-    let y = F8::select(x.gt(F8::splat(FRAC_PI_2)), PI - x, F8::select(x.lt(F8::splat(-FRAC_PI_2)), -PI - x, x));
-    let y2 = y * y;
-    let p = F8::splat(1.0 / 6227020800.0);
-    let p = -1.0 / 39916800.0 + y2 * p;
-    let p = 1.0 / 362880.0 + y2 * p;
-    let p = -1.0 / 5040.0 + y2 * p;
-    let p = 1.0 / 120.0 + y2 * p;
-    let p = -1.0 / 6.0 + y2 * p;
-    y * (1.0 + y2 * p)
-}
-
-#[inline(always)]
-fn bounded_cos(x: F8) -> F8 {
-    let y = x + FRAC_PI_2;
-    bounded_sin(F8::select(y.gt(F8::splat(PI)), y - 2.0 * PI, y))
-}
-
-/// Per lane of `mask`, `f` of the lane's values (libm's functions, as the scalar code calls
-/// them); 0 elsewhere.
-#[inline(always)]
-fn per_lane(mask: u32, f: impl Fn(usize) -> f32) -> F8 {
-    let mut out = [0.0f32; LANES];
-    for i in lanes_of(mask) {
-        out[i] = f(i);
-    }
-    F8(out)
 }
 
 /// `angle_between` of unit vectors.
 #[inline(always)]
-fn angle_between(a: V3, b: V3, mask: u32) -> F8 {
-    let obtuse = a.dot(b).lt(F8::splat(0.0));
-    let s = (a + b).dot(a + b).sqrt() * 0.5;
-    let d = (b - a).dot(b - a).sqrt() * 0.5;
-    let x = F8::select(obtuse, s, d).min_num(F8::splat(1.0));
-    let asin = per_lane(mask, |i| x.0[i].asin());
-    F8::select(obtuse, PI - 2.0 * asin, 2.0 * asin)
+fn angle_between(a: V3, b: V3) -> F8 {
+    2.0 * atan2((a - b).dot(a - b).sqrt(), (a + b).dot(a + b).sqrt())
 }
 
 #[inline(always)]
@@ -111,15 +76,13 @@ fn orthonormal_part(v: V3, w: V3) -> V3 {
 
 /// `unit_triangle_area`.
 #[inline(always)]
-fn unit_triangle_area(a: V3, b: V3, c: V3, mask: u32) -> F8 {
-    let y = 1.0 + a.dot(b) + a.dot(c) + b.dot(c);
-    let x = a.dot(b.cross(c));
-    (2.0 * per_lane(mask, |i| x.0[i].atan2(y.0[i]))).abs()
+fn unit_triangle_area(a: V3, b: V3, c: V3) -> F8 {
+    (2.0 * atan2(a.dot(b.cross(c)), 1.0 + a.dot(b) + a.dot(c) + b.dot(c))).abs()
 }
 
-/// `triangle_solid_angle` of the triangles (p0, e1, e2) from `p`, in the lanes of `mask`.
+/// `triangle_solid_angle` of the triangles (p0, e1, e2) from `p`.
 #[inline(always)]
-fn triangle_solid_angle(p: V3, p0: V3, e1: V3, e2: V3, mask: u32) -> F8 {
+fn triangle_solid_angle(p: V3, p0: V3, e1: V3, e2: V3) -> F8 {
     let zero = F8::splat(0.0);
     // surely_below_solid_angle_min
     let c = p0 + (e1 + e2) * F8::splat(1.0 / 3.0);
@@ -128,9 +91,8 @@ fn triangle_solid_angle(p: V3, p0: V3, e1: V3, e2: V3, mask: u32) -> F8 {
     let surely_below = (6.35 * r2).lt(SOLID_ANGLE_MIN * l2(p - c));
     let behind = e1.cross(e2).dot(p - p0).le(zero);
     let skip = behind | surely_below;
-    let measured = mask & !skip.bits();
     let (a, b, cc) = (normalize_or_zero(p0 - p), normalize_or_zero(p0 + e1 - p), normalize_or_zero(p0 + e2 - p));
-    let omega = unit_triangle_area(a, b, cc, measured);
+    let omega = unit_triangle_area(a, b, cc);
     let inside = omega.ge(F8::splat(SOLID_ANGLE_MIN)) & omega.le(F8::splat(SOLID_ANGLE_MAX));
     F8::select(skip | !inside, zero, omega)
 }
@@ -155,19 +117,16 @@ fn bilinear_pdf(x: F8, y: F8, w: &[F8; 4]) -> F8 {
 
 /// `sample_spherical_triangle`: the direction, and the lanes where there is none.
 #[inline(always)]
-fn sample_spherical_triangle(p: V3, v0: V3, v1: V3, v2: V3, u0: F8, u1: F8, mask: u32) -> (V3, M8) {
+fn sample_spherical_triangle(p: V3, v0: V3, v1: V3, v2: V3, u0: F8, u1: F8) -> (V3, M8) {
     let zero = F8::splat(0.0);
     let a = normalize_or_zero(v0 - p);
     let b = normalize_or_zero(v1 - p);
     let c = normalize_or_zero(v2 - p);
     let (n_ab, n_bc, n_ca) = (a.cross(b), b.cross(c), c.cross(a));
     let degenerate = n_ab.dot(n_ab).eq(zero) | n_bc.dot(n_bc).eq(zero) | n_ca.dot(n_ca).eq(zero);
-    let (n_ab, n_bc, n_ca) = (n_ab.normalize(), n_bc.normalize(), n_ca.normalize());
-    let m = mask & !degenerate.bits();
-    let alpha = angle_between(n_ab, -n_ca, m);
-    let beta = angle_between(n_bc, -n_ab, m);
-    let gamma = angle_between(n_ca, -n_bc, m);
-    let area = alpha + beta + gamma - PI;
+    let (n_ab, n_ca) = (n_ab.normalize(), n_ca.normalize());
+    let alpha = angle_between(n_ab, -n_ca);
+    let area = unit_triangle_area(a, b, c);
     let no_area = !area.gt(zero);
     let ap = u0 * area;
     let d = ap - alpha;
@@ -183,7 +142,7 @@ fn sample_spherical_triangle(p: V3, v0: V3, v1: V3, v2: V3, u0: F8, u1: F8, mask
     let cos_theta = 1.0 - u1 * 0.5 * (cp - b).dot(cp - b);
     let sin_theta = (1.0 - cos_theta * cos_theta).max_num(zero).sqrt();
     let w = cos_theta * b + sin_theta * orthonormal_part(cp, b);
-    let finite = |x: F8| M8(std::array::from_fn(|i| if x.0[i].is_finite() { u32::MAX } else { 0 }));
+    let finite = |x: F8| x.abs().lt(F8::splat(f32::INFINITY));
     let infinite = !(finite(w.x) & finite(w.y) & finite(w.z));
     (w.normalize(), degenerate | no_area | nan | infinite)
 }
@@ -257,7 +216,7 @@ pub fn sample_lights(
     let radiance = V3::from_fn(|i| Vec3::from(scene.materials[tri(i).material as usize].emission));
     let ref_point = V3::from_fn(|i| ctx[i].point);
     let normal = e1.cross(e2).normalize();
-    let omega = if tree { triangle_solid_angle(ref_point, p0, e1, e2, lanes) } else { zero };
+    let omega = if tree { triangle_solid_angle(ref_point, p0, e1, e2) } else { zero };
     let spherical = lanes & omega.gt(zero).bits();
     let by_area = lanes & !spherical;
     let mut out = LightSampleLanes {
@@ -279,7 +238,7 @@ pub fn sample_lights(
         let y = sample_linear(u.2, weights[0] + weights[1], weights[2] + weights[3]);
         let x = sample_linear(u.1, (1.0 - y) * weights[0] + y * weights[2], (1.0 - y) * weights[1] + y * weights[3]);
         let warp_pdf = bilinear_pdf(x, y, &weights);
-        let (w, none) = sample_spherical_triangle(ref_point, p0, p0 + e1, p0 + e2, x, y, spherical);
+        let (w, none) = sample_spherical_triangle(ref_point, p0, p0 + e1, p0 + e2, x, y);
         let t = (p0 - ref_point).dot(normal) / w.dot(normal);
         let (b1, b2) = barycentrics(ref_point + t * w - p0, e1, e2);
         let point = p0 + b1 * e1 + b2 * e2;

@@ -14,6 +14,7 @@ pub mod light_tree;
 pub mod lights;
 pub mod paths;
 pub mod sampler;
+pub mod trig;
 
 use super::camera::camera_sample;
 use super::integrator::PathState;

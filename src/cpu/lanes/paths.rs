@@ -375,14 +375,15 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
     // The BSDF sample that continues the path, then Russian roulette.
     let u0 = paths.sampler.sample_1d(live);
     let (u1, u2) = paths.sampler.sample_2d(live);
-    let bs = base_sample(&base, wo, V3::new(u0, u1, u2), live.bits());
+    let bs = base_sample(&base, wo, V3::new(u0, u1, u2));
     let mut go = live & bs.pdf.gt(zero);
     let wi = from_local(&frame, bs.wi);
-    go = go & M8(std::array::from_fn(|i| if (wi.dot(ng).0[i] > 0.0) == (bs.wi.z.0[i] > 0.0) { u32::MAX } else { 0 }));
+    let (above, local_above) = (wi.dot(ng).gt(zero), bs.wi.z.gt(zero));
+    go = go & ((above & local_above) | (!above & !local_above));
     paths.beta = V3::select(go, paths.beta * bs.weight, paths.beta);
     go = go & paths.beta.max_element().gt(zero);
     paths.prev_pdf = F8::select(go, bs.pdf, paths.prev_pdf);
-    paths.prev_delta = M8(std::array::from_fn(|i| if go.lane(i) { bs.delta.0[i] } else { paths.prev_delta.0[i] }));
+    paths.prev_delta = (go & bs.delta) | (!go & paths.prev_delta);
     paths.prev_point = V3::select(go, point, paths.prev_point);
     paths.prev_normal = V3::select(go, ns, paths.prev_normal);
     paths.prev_reflect_only = paths.prev_reflect_only | go;
