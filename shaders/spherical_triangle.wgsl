@@ -4,7 +4,7 @@
 // the same branch through `spherical_triangle_area`. Twin: src/cpu/spherical_triangle.rs.
 #include "common.wgsl"
 
-const SOLID_ANGLE_MIN: f32 = 2e-2;
+const SOLID_ANGLE_MIN: f32 = 0.1;
 const SOLID_ANGLE_MAX: f32 = 6.22;
 
 fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
