@@ -116,17 +116,22 @@ unsafe fn intersect_cw_node_avx2(node: &CwNode, origin: Vec3, inv_dir: Vec3, t_m
     let ((near_x, far_x), (near_y, far_y), (near_z, far_z)) = (slab(&node.qx, 0), slab(&node.qy, 1), slab(&node.qz, 2));
     let t_enter = _mm256_max_ps(_mm256_max_ps(near_x, near_y), _mm256_max_ps(near_z, _mm256_setzero_ps()));
     let t_exit = _mm256_min_ps(_mm256_min_ps(far_x, far_y), _mm256_min_ps(far_z, _mm256_set1_ps(t_max)));
-    let mut hits = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(t_enter, t_exit)) as u32;
-    let mut mask = 0;
-    while hits != 0 {
-        let child = hits.trailing_zeros();
-        hits &= hits - 1;
-        let child_meta = (node.child_meta[(child >> 2) as usize] >> (8 * (child & 3))) & 0xff;
-        let is_inner = child_meta & (child_meta << 1) & 0x10 != 0;
-        let bit_index = (child_meta ^ if is_inner { oct_inv4 & 0xff } else { 0 }) & 0x1f;
-        mask |= ((child_meta >> 5) & 7) << bit_index;
-    }
-    mask
+    let hits = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LE_OS>(t_enter, t_exit));
+    // Each hit child's bits, all eight at once (no branch per child: which children a ray
+    // hits is unpredictable): the scalar loop's `child_meta`, `is_inner` and `bit_index`.
+    let meta = _mm256_cvtepu8_epi32(_mm_set_epi32(0, 0, node.child_meta[1] as i32, node.child_meta[0] as i32));
+    let marker = _mm256_set1_epi32(0x10);
+    let is_inner =
+        _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_and_si256(meta, _mm256_slli_epi32::<1>(meta)), marker), marker);
+    let flip = _mm256_and_si256(is_inner, _mm256_set1_epi32((oct_inv4 & 0xff) as i32));
+    let bit_index = _mm256_and_si256(_mm256_xor_si256(meta, flip), _mm256_set1_epi32(0x1f));
+    let bits = _mm256_and_si256(_mm256_srli_epi32::<5>(meta), _mm256_set1_epi32(7));
+    let m = _mm256_and_si256(_mm256_sllv_epi32(bits, bit_index), hits);
+    // OR of the eight lanes.
+    let m = _mm_or_si128(_mm256_castsi256_si128(m), _mm256_extracti128_si256::<1>(m));
+    let m = _mm_or_si128(m, _mm_shuffle_epi32::<0b01_00_11_10>(m));
+    let m = _mm_or_si128(m, _mm_shuffle_epi32::<0b10_11_00_01>(m));
+    _mm_cvtsi128_si32(m) as u32
 }
 
 /// The leaf triangles `tris` (bits k: triangle `base + k`) of a node against `ray`, eight at a

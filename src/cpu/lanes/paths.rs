@@ -10,16 +10,16 @@
 use super::bsdf::{BaseLanes, base_eval, base_pdf, base_sample, is_plain};
 use super::lane::{F8, M8, U8, V3};
 use super::light_tree::sample_light_tree_lanes;
-use super::lights::sample_lights;
+use super::lights::{LightSampleLanes, sample_lights};
 use super::sampler::SamplerLanes;
 use super::{LANES, lanes_of};
 use crate::Strategy;
 use crate::aov::AovSample;
-use crate::cpu::bvh::{Hit, NO_HIT, intersect_closest};
+use crate::cpu::bvh::{Hit, NO_HIT, intersect_closest, occluded};
 use crate::cpu::common::{INF, Ray};
 use crate::cpu::integrator::{
-    PathState, connect_evaluated, light_candidates, next_event_wanted, path_escaped, path_next_event, path_scatter,
-    path_strategy, path_surface, spawn_point,
+    PathState, light_candidates, next_event_wanted, path_escaped, path_next_event, path_scatter, path_strategy,
+    path_surface,
 };
 use crate::cpu::light_tree::LightContext;
 use crate::cpu::lights::{light_pdf, tree_u};
@@ -209,6 +209,54 @@ fn mis_weight(strategy: Strategy, pdf_f: F8, pdf_g: F8) -> F8 {
     F8::select(pdf_f.le(F8::splat(0.0)), F8::splat(0.0), w)
 }
 
+/// `offset_ray` in lanes: `p` moved off its surface along `n` by a few ulps (a fixed step
+/// near the origin), the scalar's operations lane by lane.
+#[inline(always)]
+fn offset_ray(p: V3, n: V3) -> V3 {
+    let axis = |pc: F8, nc: F8| {
+        F8::from_fn(|i| {
+            let (pc, nc) = (pc.0[i], nc.0[i]);
+            let o = (256.0 * nc) as i32;
+            // (wrapping_neg: the scalar's `-o` wherever it is defined; lanes not in use may
+            // hold anything.)
+            let pi =
+                f32::from_bits((pc.to_bits() as i32).wrapping_add(if pc < 0.0 { o.wrapping_neg() } else { o }) as u32);
+            if pc.abs() < 1.0 / 32.0 { pc + (1.0 / 65536.0) * nc } else { pi }
+        })
+    };
+    V3::new(axis(p.x, n.x), axis(p.y, n.y), axis(p.z, n.z))
+}
+
+/// `spawn_point` in lanes: the origin of a ray leaving `point` towards `wi`.
+#[inline(always)]
+fn spawn_point(point: V3, ng: V3, wi: V3) -> V3 {
+    offset_ray(point, V3::select(wi.dot(ng).gt(F8::splat(0.0)), ng, -ng))
+}
+
+/// `connect_evaluated` in the lanes of `m` (light samples with a density): the side test,
+/// then one shadow ray per lane still open; f · |cos θ| · L where unblocked, else 0.
+#[inline(always)]
+fn connect_evaluated(scene: &PackedScene, point: V3, ng: V3, ls: &LightSampleLanes, wi_local: V3, f: V3, m: M8) -> V3 {
+    let zero = F8::splat(0.0);
+    let (above, local_above) = (ls.wi.dot(ng).gt(zero), wi_local.z.gt(zero));
+    let same_side = (above & local_above) | (!above & !local_above);
+    let mut open = m & same_side & !f.max_element().le(zero);
+    if open.bits() == 0 {
+        return V3::splat(Vec3::ZERO);
+    }
+    // `shadow_ray`: to an emitter's point moved off its surface (extent 1), else along wi.
+    let origin = offset_ray(point, V3::select(above, ng, -ng));
+    let infinite = ls.dist.eq(F8::splat(INF));
+    let dir = V3::select(infinite, ls.wi, offset_ray(ls.point, ls.normal) - origin);
+    for i in lanes_of(open.bits()) {
+        let t_max = if infinite.lane(i) { INF } else { 1.0 };
+        if occluded(scene, &Ray { origin: origin.lane(i), dir: dir.lane(i) }, t_max) {
+            open.set_lane(i, false);
+        }
+    }
+    V3::select(open, f * wi_local.z.abs() * ls.radiance, V3::splat(Vec3::ZERO))
+}
+
 /// `frame_from_normal` in lanes: (t, b, n).
 #[inline(always)]
 fn frame_from_normal(n: V3) -> [V3; 3] {
@@ -351,13 +399,7 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
             let wi_local = to_local(&frame, ls.wi);
             let f = base_eval(&base, wo, wi_local);
             let pdf_b = base_pdf(&base, wo, wi_local);
-            let mut c = V3::splat(Vec3::ZERO);
-            for i in lanes_of(connecting.bits()) {
-                if ls.pdf.0[i] > 0.0 {
-                    let l = ls.lane(i);
-                    c.set_lane(i, connect_evaluated(scene, point.lane(i), ng.lane(i), &l, wi_local.lane(i), f.lane(i)));
-                }
-            }
+            let c = connect_evaluated(scene, point, ng, &ls, wi_local, f, connecting & ls.pdf.gt(zero));
             let add = connecting & c.max_element().gt(zero);
             if add.bits() != 0 {
                 let w = F8::select(
@@ -387,9 +429,7 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
     paths.prev_point = V3::select(go, point, paths.prev_point);
     paths.prev_normal = V3::select(go, ns, paths.prev_normal);
     paths.prev_reflect_only = paths.prev_reflect_only | go;
-    for i in lanes_of(go.bits()) {
-        paths.origin.set_lane(i, spawn_point(point.lane(i), ng.lane(i), wi.lane(i)));
-    }
+    paths.origin = V3::select(go, spawn_point(point, ng, wi), paths.origin);
     paths.dir = V3::select(go, wi, paths.dir);
     let roulette = go & paths.depth.ge(params.rr_depth);
     if roulette.bits() != 0 {
