@@ -48,6 +48,10 @@ fn group_shares_lanes(c: &Contexts, g: &LightGroup) -> ([F8; WIDTH], M8) {
     let mut far = [zero; WIDTH];
     let mut near = [zero; WIDTH];
     for k in 0..WIDTH {
+        if g.phi[k] <= 0.0 {
+            // No power (an empty slot): dead for every path, as the selects below make it.
+            continue;
+        }
         // The child's constants, as `group_importance` has them in its lane k.
         let phi = F8::splat(g.phi[k]);
         let lo = [0, 1, 2].map(|a| F8::splat(g.lo[a][k]));

@@ -80,9 +80,10 @@ fn unit_triangle_area(a: V3, b: V3, c: V3) -> F8 {
     (2.0 * atan2(a.dot(b.cross(c)), 1.0 + a.dot(b) + a.dot(c) + b.dot(c))).abs()
 }
 
-/// `triangle_solid_angle` of the triangles (p0, e1, e2) from `p`.
+/// `triangle_solid_angle` of the triangles (p0, e1, e2) from `p` in the lanes of `mask` (0
+/// in the others).
 #[inline(always)]
-fn triangle_solid_angle(p: V3, p0: V3, e1: V3, e2: V3) -> F8 {
+fn triangle_solid_angle(p: V3, p0: V3, e1: V3, e2: V3, mask: u32) -> F8 {
     let zero = F8::splat(0.0);
     // surely_below_solid_angle_min
     let c = p0 + (e1 + e2) * F8::splat(1.0 / 3.0);
@@ -90,7 +91,11 @@ fn triangle_solid_angle(p: V3, p0: V3, e1: V3, e2: V3) -> F8 {
     let r2 = l2(p0 - c).max_num(l2(p0 + e1 - c)).max_num(l2(p0 + e2 - c));
     let surely_below = (6.35 * r2).lt(SOLID_ANGLE_MIN * l2(p - c));
     let behind = e1.cross(e2).dot(p - p0).le(zero);
-    let skip = behind | surely_below;
+    let skip = behind | surely_below | !M8::from_bits(mask);
+    if skip.bits() == M8::splat(true).bits() {
+        // Every lane takes the scalar's early return (the common case far from a lamp).
+        return zero;
+    }
     let (a, b, cc) = (normalize_or_zero(p0 - p), normalize_or_zero(p0 + e1 - p), normalize_or_zero(p0 + e2 - p));
     let omega = unit_triangle_area(a, b, cc);
     let inside = omega.ge(F8::splat(SOLID_ANGLE_MIN)) & omega.le(F8::splat(SOLID_ANGLE_MAX));
@@ -216,7 +221,7 @@ pub fn sample_lights(
     let radiance = V3::from_fn(|i| Vec3::from(scene.materials[tri(i).material as usize].emission));
     let ref_point = V3::from_fn(|i| ctx[i].point);
     let normal = e1.cross(e2).normalize();
-    let omega = if tree { triangle_solid_angle(ref_point, p0, e1, e2) } else { zero };
+    let omega = if tree { triangle_solid_angle(ref_point, p0, e1, e2, lanes) } else { zero };
     let spherical = lanes & omega.gt(zero).bits();
     let by_area = lanes & !spherical;
     let mut out = LightSampleLanes {
