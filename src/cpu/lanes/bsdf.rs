@@ -44,8 +44,8 @@ impl BaseLanes {
     /// material read zeros and are not to be used).
     #[inline(always)]
     pub fn gather<'a>(m: impl Fn(usize) -> Option<&'a Material>, p: impl Fn(usize) -> glam::Vec4) -> BaseLanes {
-        let ms: [Option<&Material>; super::LANES] = std::array::from_fn(m);
-        let ps: [glam::Vec4; super::LANES] = std::array::from_fn(p);
+        let ms: [Option<&Material>; super::LANES] = super::lane::per_lane(m);
+        let ps: [glam::Vec4; super::LANES] = super::lane::per_lane(p);
         let f = |get: fn(&Material) -> f32| F8::from_fn(|i| ms[i].map_or(0.0, get));
         let v = |get: fn(&Material) -> [f32; 3]| V3::from_fn(|i| ms[i].map_or(Vec3::ZERO, |m| Vec3::from(get(m))));
         BaseLanes {

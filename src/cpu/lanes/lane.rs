@@ -36,6 +36,17 @@ fn lanes<T: Copy + Default>(mut f: impl FnMut(usize) -> T) -> [T; W] {
     out
 }
 
+/// `[f(0), …, f(W − 1)]` for any lane type, inlined (`std::array::from_fn` and `map` over
+/// arrays of lanes stay calls, out of the AVX2 code: measured, BENCHMARKS.md session 21).
+#[inline(always)]
+pub fn per_lane<T: Copy>(mut f: impl FnMut(usize) -> T) -> [T; W] {
+    let mut out = [f(0); W];
+    for (i, o) in out.iter_mut().enumerate().skip(1) {
+        *o = f(i);
+    }
+    out
+}
+
 impl F8 {
     #[inline(always)]
     pub fn splat(x: f32) -> F8 {
@@ -174,6 +185,12 @@ impl M8 {
     #[inline(always)]
     pub fn splat(b: bool) -> M8 {
         M8([if b { u32::MAX } else { 0 }; W])
+    }
+
+    /// Lane i set where `f(i)` is true.
+    #[inline(always)]
+    pub fn from_fn(mut f: impl FnMut(usize) -> bool) -> M8 {
+        M8(lanes(|i| if f(i) { u32::MAX } else { 0 }))
     }
 
     /// Lane i set where bit i of `bits` is.

@@ -36,6 +36,12 @@ struct Contexts {
     reflect_only: M8,
 }
 
+/// `[f(0), f(1), f(2)]`, inlined (an array's `map` is a call).
+#[inline(always)]
+fn axes(f: impl Fn(usize) -> F8) -> [F8; 3] {
+    [f(0), f(1), f(2)]
+}
+
 /// `group_shares` of group `g` for every path in lanes: the four children's shares (lane i:
 /// path i), and the lanes at a dead end.
 #[inline(always)]
@@ -54,23 +60,23 @@ fn group_shares_lanes(c: &Contexts, g: &LightGroup) -> ([F8; WIDTH], M8) {
         }
         // The child's constants, as `group_importance` has them in its lane k.
         let phi = F8::splat(g.phi[k]);
-        let lo = [0, 1, 2].map(|a| F8::splat(g.lo[a][k]));
-        let hi = [0, 1, 2].map(|a| F8::splat(g.hi[a][k]));
-        let pc = [0, 1, 2].map(|a| F8::splat(0.5 * (g.lo[a][k] + g.hi[a][k])));
-        let half = [0, 1, 2].map(|a| F8::splat(0.5 * (g.hi[a][k] - g.lo[a][k])));
-        let below = dot3([0, 1, 2].map(|a| pc[a] - p[a]), n) + dot3(half, n.map(F8::abs));
+        let lo = axes(|a| F8::splat(g.lo[a][k]));
+        let hi = axes(|a| F8::splat(g.hi[a][k]));
+        let pc = axes(|a| F8::splat(0.5 * (g.lo[a][k] + g.hi[a][k])));
+        let half = axes(|a| F8::splat(0.5 * (g.hi[a][k] - g.lo[a][k])));
+        let below = dot3(axes(|a| pc[a] - p[a]), n) + dot3(half, axes(|a| n[a].abs()));
         let dead = phi.le(zero) | (c.reflect_only & below.le(zero));
         let r2 = dot3(half, half);
-        let to_p = [0, 1, 2].map(|a| p[a] - pc[a]);
+        let to_p = axes(|a| p[a] - pc[a]);
         let dist2 = dot3(to_p, to_p);
-        let outside = [0, 1, 2].map(|a| p[a] - min_ps(max_ps(p[a], lo[a]), hi[a]));
+        let outside = axes(|a| p[a] - min_ps(max_ps(p[a], lo[a]), hi[a]));
         let tiny = F8::splat(1e-20);
         let d2_far = max_ps(max_ps(dist2, r2), tiny);
         let d2_near = max_ps(max_ps(dot3(outside, outside), 0.25 * r2), tiny);
         let inside = dist2.le(r2);
         let inv_d = 1.0 / dist2.sqrt();
-        let wi = to_p.map(|x| x * inv_d);
-        let mut cos_w = dot3([0, 1, 2].map(|a| F8::splat(g.axis[a][k])), wi);
+        let wi = axes(|a| to_p[a] * inv_d);
+        let mut cos_w = dot3(axes(|a| F8::splat(g.axis[a][k])), wi);
         if g.next[k] & LIGHT_TWO_SIDED != 0 {
             cos_w = cos_w.abs();
         }
@@ -99,8 +105,8 @@ fn group_shares_lanes(c: &Contexts, g: &LightGroup) -> ([F8; WIDTH], M8) {
         e = F8::select(dead, zero, e);
         // `group_shares`' plane test of a one-sided leaf triangle.
         if g.one_sided[k] != 0 {
-            let plane_n = [0, 1, 2].map(|a| F8::splat(g.plane_n[a][k]));
-            let side = dot3(plane_n, [0, 1, 2].map(|a| p[a] - F8::splat(g.plane_p0[a][k])));
+            let plane_n = axes(|a| F8::splat(g.plane_n[a][k]));
+            let side = dot3(plane_n, axes(|a| p[a] - F8::splat(g.plane_p0[a][k])));
             let behind = f.gt(zero) & side.le(zero);
             f = F8::select(behind, zero, f);
             e = F8::select(behind, zero, e);
@@ -140,7 +146,7 @@ pub fn sample_light_tree_lanes(
     let contexts = Contexts {
         point: V3::from_fn(|i| ctx[i].point),
         normal: V3::from_fn(|i| ctx[i].normal),
-        reflect_only: M8(std::array::from_fn(|i| if ctx[i].reflect_only { u32::MAX } else { 0 })),
+        reflect_only: M8::from_fn(|i| ctx[i].reflect_only),
     };
     let mut group = [0u32; LANES];
     let mut u = *u;
@@ -159,7 +165,7 @@ pub fn sample_light_tree_lanes(
         let in_lanes = if here.count_ones() >= SHARED_GROUP { Some(group_shares_lanes(&contexts, node)) } else { None };
         for i in lanes_of(here) {
             let shares = match &in_lanes {
-                Some((s, end)) => (!end.lane(i)).then(|| s.map(|x| x.0[i])),
+                Some((s, end)) => (!end.lane(i)).then(|| [s[0].0[i], s[1].0[i], s[2].0[i], s[3].0[i]]),
                 None => group_shares(scene, params, &ctx[i], node),
             };
             let Some(shares) = shares else {

@@ -60,5 +60,5 @@ pub fn render_packet(scene: &PackedScene, params: &Params, x0: u32, y: u32, mask
     }
     let mut paths = Paths::from_states(&states);
     trace_paths(scene, params, &mut paths, mask);
-    std::array::from_fn(|i| (paths.radiance.lane(i), paths.aov[i]))
+    lane::per_lane(|i| (paths.radiance.lane(i), paths.aov[i]))
 }

@@ -8,7 +8,7 @@
 //! selection and the light sample, an emitter hit's light density, the shadow test.
 
 use super::bsdf::{BaseLanes, base_eval, base_pdf, base_sample, is_plain};
-use super::lane::{F8, M8, U8, V3};
+use super::lane::{F8, M8, U8, V3, per_lane};
 use super::light_tree::sample_light_tree_lanes;
 use super::lights::{LightSampleLanes, sample_lights};
 use super::sampler::SamplerLanes;
@@ -50,7 +50,7 @@ pub struct Paths {
 
 impl Paths {
     pub fn from_states(s: &[PathState; LANES]) -> Paths {
-        let mask = |f: &dyn Fn(&PathState) -> bool| M8(std::array::from_fn(|i| if f(&s[i]) { u32::MAX } else { 0 }));
+        let mask = |f: &dyn Fn(&PathState) -> bool| M8::from_fn(|i| f(&s[i]));
         Paths {
             origin: V3::from_fn(|i| s[i].ray.origin),
             dir: V3::from_fn(|i| s[i].ray.dir),
@@ -64,9 +64,9 @@ impl Paths {
             prev_reflect_only: mask(&|p| p.prev_ctx.reflect_only),
             aov_open: mask(&|p| p.aov_open),
             aov_weight: V3::from_fn(|i| s[i].aov_weight),
-            aov: std::array::from_fn(|i| s[i].aov),
+            aov: per_lane(|i| s[i].aov),
             channel: U8::from_fn(|i| s[i].channel),
-            sampler: SamplerLanes::from_samplers(&std::array::from_fn(|i| s[i].sampler)),
+            sampler: SamplerLanes::from_samplers(&per_lane(|i| s[i].sampler)),
         }
     }
 
@@ -301,7 +301,8 @@ fn lobe_probabilities(m: &BaseLanes, cos_o: F8, eta: F8) -> [F8; 4] {
     let w = [luminance(bsdf_fresnel(m, cos_o)), luminance(diffuse_albedo(m, cos_o)), wt, zero * 0.2126];
     let total = w[0] + w[1] + w[2] + w[3];
     let none = total.le(zero);
-    w.map(|x| F8::select(none, zero, x / total))
+    let p = |k: usize| F8::select(none, zero, w[k] / total);
+    [p(0), p(1), p(2), p(3)]
 }
 
 /// One bounce of the lanes of `lanes` (plain surfaces hit): `path_surface`, `path_next_event`
@@ -323,7 +324,7 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
     let (u, v, t) = (F8::from_fn(|i| hits[i].u), F8::from_fn(|i| hits[i].v), F8::from_fn(|i| hits[i].t));
     let point = p0 + u * e1 + v * e2;
     let ng_cross = e1.cross(e2).normalize();
-    let mirrored = M8(std::array::from_fn(|i| if tri(i).flags & TRI_MIRRORED != 0 { u32::MAX } else { 0 }));
+    let mirrored = M8::from_fn(|i| tri(i).flags & TRI_MIRRORED != 0);
     let ng_raw = V3::select(mirrored, -ng_cross, ng_cross);
     let dir = paths.dir;
     let cos_hit = dir.dot(ng_raw);
@@ -391,7 +392,7 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
                 walking |= 1 << i;
             }
         }
-        let contexts = std::array::from_fn(ctx);
+        let contexts = per_lane(ctx);
         let walks = sample_light_tree_lanes(scene, params, &contexts, &u_tree, walking);
         let ls = sample_lights(scene, params, &contexts, (u0, u1, u2), &walks, live.bits());
         let connecting = live & (ls.delta | M8::splat(strategy != Strategy::Bsdf));
