@@ -6,6 +6,10 @@
 
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
+/// Taylor coefficients of sin x from x¹³ down to x³ (±1/n!), highest power first.
+pub const SIN_COEFFICIENTS: [f32; 6] =
+    [1.0 / 6227020800.0, -1.0 / 39916800.0, 1.0 / 362880.0, -1.0 / 5040.0, 1.0 / 120.0, -1.0 / 6.0];
+
 /// sin x for |x| ≤ π (Taylor to x¹³ on [−π/2, π/2], error below 1e-9 before rounding).
 #[inline(always)]
 pub fn bounded_sin(x: f32) -> f32 {
@@ -17,12 +21,13 @@ pub fn bounded_sin(x: f32) -> f32 {
         x
     };
     let y2 = y * y;
-    let p = 1.0 / 6227020800.0;
-    let p = -1.0 / 39916800.0 + y2 * p;
-    let p = 1.0 / 362880.0 + y2 * p;
-    let p = -1.0 / 5040.0 + y2 * p;
-    let p = 1.0 / 120.0 + y2 * p;
-    let p = -1.0 / 6.0 + y2 * p;
+    let [c13, c11, c9, c7, c5, c3] = SIN_COEFFICIENTS;
+    let p = c13;
+    let p = c11 + y2 * p;
+    let p = c9 + y2 * p;
+    let p = c7 + y2 * p;
+    let p = c5 + y2 * p;
+    let p = c3 + y2 * p;
     y * (1.0 + y2 * p)
 }
 

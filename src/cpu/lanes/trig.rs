@@ -2,19 +2,20 @@
 //! selects where the scalar code branches, so each lane holds the scalar function's bits.
 
 use super::lane::F8;
-use crate::cpu::trig::{ATAN_COEFFICIENTS, TAN_PI_8};
+use crate::cpu::trig::{ATAN_COEFFICIENTS, SIN_COEFFICIENTS, TAN_PI_8};
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 #[inline(always)]
 pub fn bounded_sin(x: F8) -> F8 {
     let y = F8::select(x.gt(F8::splat(FRAC_PI_2)), PI - x, F8::select(x.lt(F8::splat(-FRAC_PI_2)), -PI - x, x));
     let y2 = y * y;
-    let p = F8::splat(1.0 / 6227020800.0);
-    let p = -1.0 / 39916800.0 + y2 * p;
-    let p = 1.0 / 362880.0 + y2 * p;
-    let p = -1.0 / 5040.0 + y2 * p;
-    let p = 1.0 / 120.0 + y2 * p;
-    let p = -1.0 / 6.0 + y2 * p;
+    let [c13, c11, c9, c7, c5, c3] = SIN_COEFFICIENTS;
+    let p = F8::splat(c13);
+    let p = c11 + y2 * p;
+    let p = c9 + y2 * p;
+    let p = c7 + y2 * p;
+    let p = c5 + y2 * p;
+    let p = c3 + y2 * p;
     y * (1.0 + y2 * p)
 }
 
