@@ -42,6 +42,35 @@ impl LightSampleLanes {
         }
     }
 
+    /// No sample in any lane.
+    #[inline(always)]
+    pub fn zero() -> LightSampleLanes {
+        let (zero, none) = (F8::splat(0.0), V3::splat(Vec3::ZERO));
+        LightSampleLanes {
+            wi: none,
+            dist: zero,
+            point: none,
+            normal: none,
+            radiance: none,
+            pdf: zero,
+            delta: M8::splat(false),
+        }
+    }
+
+    /// `a` in the lanes of `m`, else `b`.
+    #[inline(always)]
+    pub fn select(m: M8, a: &LightSampleLanes, b: &LightSampleLanes) -> LightSampleLanes {
+        LightSampleLanes {
+            wi: V3::select(m, a.wi, b.wi),
+            dist: F8::select(m, a.dist, b.dist),
+            point: V3::select(m, a.point, b.point),
+            normal: V3::select(m, a.normal, b.normal),
+            radiance: V3::select(m, a.radiance, b.radiance),
+            pdf: F8::select(m, a.pdf, b.pdf),
+            delta: (m & a.delta) | (!m & b.delta),
+        }
+    }
+
     #[inline(always)]
     fn set_lane(&mut self, i: usize, s: &LightSample) {
         self.wi.set_lane(i, s.wi);

@@ -16,14 +16,15 @@ use super::{LANES, lanes_of};
 use crate::Strategy;
 use crate::aov::AovSample;
 use crate::cpu::bvh::{Hit, NO_HIT, intersect_closest, occluded};
-use crate::cpu::common::{INF, Ray};
+use crate::cpu::common::{INF, ONE_MINUS_EPSILON, Ray};
 use crate::cpu::integrator::{
-    PathState, light_candidates, next_event_wanted, path_escaped, path_next_event, path_scatter, path_strategy,
-    path_surface,
+    GLOSSY_ROUGHNESS, PathState, candidate_pdf_scale, next_event_wanted, path_escaped, path_next_event, path_scatter,
+    path_strategy, path_surface,
 };
 use crate::cpu::light_tree::LightContext;
 use crate::cpu::lights::{light_pdf, tree_u};
 use crate::cpu::material::shading_normal;
+use crate::cpu::microfacet::DELTA_ALPHA;
 use crate::packed::{Material, PackedScene, TRI_HAS_NORMALS, TRI_MIRRORED};
 use crate::params::Params;
 use glam::{Vec3, Vec4};
@@ -140,8 +141,6 @@ fn plain_material(scene: &PackedScene, params: &Params, m: &Material, index: usi
         && !scene.material_textured[index]
         && is_plain(m)
         && Vec3::from(m.attenuation).max_element() <= 0.0
-        // Resampled light candidates (glossy surfaces with `LightSampler::Ris`) run per lane.
-        && light_candidates(params, m) == 1
 }
 
 #[inline(always)]
@@ -244,8 +243,15 @@ fn connect_evaluated(scene: &PackedScene, point: V3, ng: V3, ls: &LightSampleLan
     if open.bits() == 0 {
         return V3::splat(Vec3::ZERO);
     }
-    // `shadow_ray`: to an emitter's point moved off its surface (extent 1), else along wi.
-    let origin = offset_ray(point, V3::select(above, ng, -ng));
+    open = unoccluded(scene, offset_ray(point, V3::select(above, ng, -ng)), ls, open);
+    V3::select(open, f * wi_local.z.abs() * ls.radiance, V3::splat(Vec3::ZERO))
+}
+
+/// `unoccluded` in the lanes of `m`: the lanes whose shadow ray from `origin` (`shadow_ray`:
+/// to an emitter's point moved off its surface, extent 1, else along wi) is unblocked.
+#[inline(always)]
+fn unoccluded(scene: &PackedScene, origin: V3, ls: &LightSampleLanes, m: M8) -> M8 {
+    let mut open = m;
     let infinite = ls.dist.eq(F8::splat(INF));
     let dir = V3::select(infinite, ls.wi, offset_ray(ls.point, ls.normal) - origin);
     for i in lanes_of(open.bits()) {
@@ -254,7 +260,210 @@ fn connect_evaluated(scene: &PackedScene, point: V3, ng: V3, ls: &LightSampleLan
             open.set_lane(i, false);
         }
     }
-    V3::select(open, f * wi_local.z.abs() * ls.radiance, V3::splat(Vec3::ZERO))
+    open
+}
+
+/// `sample_light` for the lanes of `m` from their contexts, with the next three numbers of
+/// each lane's sampler: the tree's walks side by side, then the emitters' samples.
+#[inline(always)]
+fn sample_light(
+    scene: &PackedScene,
+    params: &Params,
+    contexts: &[LightContext; LANES],
+    sampler: &mut SamplerLanes,
+    m: M8,
+) -> LightSampleLanes {
+    let u0 = sampler.sample_1d(m);
+    let (u1, u2) = sampler.sample_2d(m);
+    let mut walking = 0u32;
+    let mut u_tree = [0.0f32; LANES];
+    for i in lanes_of(m.bits()) {
+        if let Some(x) = tree_u(params, u0.0[i]) {
+            u_tree[i] = x;
+            walking |= 1 << i;
+        }
+    }
+    let walks = sample_light_tree_lanes(scene, params, contexts, &u_tree, walking);
+    sample_lights(scene, params, contexts, (u0, u1, u2), &walks, m.bits())
+}
+
+/// The surface vertex of a packet's plain lanes, as next-event estimation reads it.
+struct VertexLanes<'a> {
+    point: V3,
+    ng: V3,
+    frame: [V3; 3],
+    wo: V3,
+    base: &'a BaseLanes,
+}
+
+/// Weighted reservoir sampling of light candidates, lane by lane: `path_resample_lights`'s
+/// stream (each candidate weighed by its MIS weight times its target over its density, one
+/// kept in proportion to its weight), the operations lane by lane.
+struct Reservoir {
+    u_pick: F8,
+    w_sum: F8,
+    kept: LightSampleLanes,
+    kept_c: V3,
+    kept_target: F8,
+    kept_any: M8,
+}
+
+impl Reservoir {
+    #[inline(always)]
+    fn new(u_pick: F8) -> Reservoir {
+        let zero = F8::splat(0.0);
+        Reservoir {
+            u_pick,
+            w_sum: zero,
+            kept: LightSampleLanes::zero(),
+            kept_c: V3::splat(Vec3::ZERO),
+            kept_target: zero,
+            kept_any: M8::splat(false),
+        }
+    }
+
+    /// The candidate `ls`, one of `count`, in the lanes of `m`.
+    #[inline(always)]
+    fn stream(&mut self, strategy: Strategy, sv: &VertexLanes, ls: &LightSampleLanes, count: u32, m: M8) {
+        let zero = F8::splat(0.0);
+        let mut open = m & ls.pdf.gt(zero) & (ls.delta | M8::splat(strategy != Strategy::Bsdf));
+        let wi_local = to_local(&sv.frame, ls.wi);
+        let (above, local_above) = (ls.wi.dot(sv.ng).gt(zero), wi_local.z.gt(zero));
+        open = open & ((above & local_above) | (!above & !local_above));
+        if open.bits() == 0 {
+            return;
+        }
+        let c = base_eval(sv.base, sv.wo, wi_local) * wi_local.z.abs() * ls.radiance;
+        let target = luminance(c);
+        open = open & target.gt(zero);
+        let share = F8::splat(1.0 / count as f32);
+        let pdf_b = base_pdf(sv.base, sv.wo, wi_local) / candidate_pdf_scale(strategy, count);
+        let unweighed = M8::splat(strategy == Strategy::Light) | ls.delta;
+        let mis = F8::select(unweighed, share, share * mis_weight(strategy, ls.pdf, pdf_b));
+        let w = mis * target / ls.pdf;
+        open = open & w.gt(zero);
+        if open.bits() == 0 {
+            return;
+        }
+        self.w_sum = F8::select(open, self.w_sum + w, self.w_sum);
+        // One number picks among the candidates as they stream by, rescaled after each.
+        let p = w / self.w_sum;
+        let pick = open & self.u_pick.lt(p);
+        let u = self.u_pick;
+        let rescaled = F8::select(pick, u / p, (u - p) / (1.0 - p)).min_num(F8::splat(ONE_MINUS_EPSILON));
+        self.u_pick = F8::select(open, rescaled, u);
+        self.kept = LightSampleLanes::select(pick, ls, &self.kept);
+        self.kept_c = V3::select(pick, c, self.kept_c);
+        self.kept_target = F8::select(pick, target, self.kept_target);
+        self.kept_any = self.kept_any | pick;
+    }
+
+    /// The kept candidate connected (one shadow ray per lane), its contribution scaled by the
+    /// weights' sum over its target.
+    #[inline(always)]
+    fn connect(&self, scene: &PackedScene, params: &Params, paths: &mut Paths, sv: &VertexLanes) {
+        if self.kept_any.bits() == 0 {
+            return;
+        }
+        let lit = unoccluded(scene, spawn_point(sv.point, sv.ng, self.kept.wi), &self.kept, self.kept_any);
+        if lit.bits() != 0 {
+            let depth1 = paths.depth.map(|d| d + 1);
+            let c = paths.beta * self.kept_c * (self.w_sum / self.kept_target);
+            paths.radiance = V3::select(lit, paths.radiance + clamp_contribution(params, c, depth1), paths.radiance);
+        }
+    }
+}
+
+/// `path_resample_lights` in the lanes of `m` (glossy surfaces, `params.light_candidates`
+/// candidates each): the candidates drawn, weighed and one kept per lane as the scalar streams
+/// them, then one shadow ray per lane. Out of line, so that the packet kernel, which most
+/// bounces run without it, stays as it was (and quick to compile); compiled for AVX2 where the
+/// CPU has it (checked at run time, a cached load), as `trace_paths`.
+#[inline(never)]
+fn resample_lights(
+    scene: &PackedScene,
+    params: &Params,
+    paths: &mut Paths,
+    contexts: &[LightContext; LANES],
+    sv: &VertexLanes,
+    m: M8,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above).
+        return unsafe { resample_lights_avx2(scene, params, paths, contexts, sv, m) };
+    }
+    resample_lights_loop(scene, params, paths, contexts, sv, m)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn resample_lights_avx2(
+    scene: &PackedScene,
+    params: &Params,
+    paths: &mut Paths,
+    contexts: &[LightContext; LANES],
+    sv: &VertexLanes,
+    m: M8,
+) {
+    resample_lights_loop(scene, params, paths, contexts, sv, m)
+}
+
+#[inline(always)]
+fn resample_lights_loop(
+    scene: &PackedScene,
+    params: &Params,
+    paths: &mut Paths,
+    contexts: &[LightContext; LANES],
+    sv: &VertexLanes,
+    m: M8,
+) {
+    let strategy = path_strategy(params);
+    let count = params.light_candidates;
+    let mut reservoir = Reservoir::new(F8::splat(0.0));
+    for k in 0..count {
+        // Each lane's draws in the scalar's order: candidate 0, the picking number, the rest.
+        let ls = sample_light(scene, params, contexts, &mut paths.sampler, m);
+        if k == 0 {
+            reservoir.u_pick = paths.sampler.sample_1d(m);
+        }
+        reservoir.stream(strategy, sv, &ls, count, m);
+    }
+    reservoir.connect(scene, params, paths, sv);
+}
+
+/// `path_connect_light` in the lanes of `m`: the light sample connected by a shadow ray and
+/// weighted by MIS.
+#[inline(always)]
+fn connect_light(
+    scene: &PackedScene,
+    params: &Params,
+    paths: &mut Paths,
+    sv: &VertexLanes,
+    ls: &LightSampleLanes,
+    m: M8,
+) {
+    let strategy = path_strategy(params);
+    let zero = F8::splat(0.0);
+    let connecting = m & (ls.delta | M8::splat(strategy != Strategy::Bsdf));
+    if connecting.bits() == 0 {
+        return;
+    }
+    let wi_local = to_local(&sv.frame, ls.wi);
+    let f = base_eval(sv.base, sv.wo, wi_local);
+    let pdf_b = base_pdf(sv.base, sv.wo, wi_local);
+    let c = connect_evaluated(scene, sv.point, sv.ng, ls, wi_local, f, connecting & ls.pdf.gt(zero));
+    let add = connecting & c.max_element().gt(zero);
+    if add.bits() != 0 {
+        let w = F8::select(
+            M8::splat(strategy == Strategy::Light) | ls.delta,
+            F8::splat(1.0),
+            mis_weight(strategy, ls.pdf, pdf_b),
+        );
+        let depth1 = paths.depth.map(|d| d + 1);
+        let contribution = clamp_contribution(params, paths.beta * c * (w / ls.pdf), depth1);
+        paths.radiance = V3::select(add, paths.radiance + contribution, paths.radiance);
+    }
 }
 
 /// `frame_from_normal` in lanes: (t, b, n).
@@ -379,39 +588,26 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
     let mut base = base;
     base.p = lobe_probabilities(&base, wo.z, eta);
 
-    // Next-event estimation.
+    // Next-event estimation: one light sample, or at glossy surfaces the one kept of several.
+    let count = params.light_candidates;
+    // `light_candidates(params, m) > 1`: a plain material has no coat, so glossy = its base's
+    // roughness (`material_glossy`), tested in lanes.
+    let resampled = if params.light_candidates > 1 && strategy != Strategy::Bsdf {
+        let r = base.roughness;
+        live & r.lt(F8::splat(GLOSSY_ROUGHNESS)) & (r * r).ge(F8::splat(DELTA_ALPHA))
+    } else {
+        M8::splat(false)
+    };
     if next_event_wanted(params) {
-        let u0 = paths.sampler.sample_1d(live);
-        let (u1, u2) = paths.sampler.sample_2d(live);
-        let ctx = |i: usize| LightContext { point: point.lane(i), normal: ns.lane(i), reflect_only: true };
-        let mut walking = 0u32;
-        let mut u_tree = [0.0f32; LANES];
-        for i in lanes_of(live.bits()) {
-            if let Some(x) = tree_u(params, u0.0[i]) {
-                u_tree[i] = x;
-                walking |= 1 << i;
-            }
+        let contexts = per_lane(|i| LightContext { point: point.lane(i), normal: ns.lane(i), reflect_only: true });
+        let sv = VertexLanes { point, ng, frame, wo, base: &base };
+        let single = live & !resampled;
+        if single.bits() != 0 {
+            let ls = sample_light(scene, params, &contexts, &mut paths.sampler, single);
+            connect_light(scene, params, paths, &sv, &ls, single);
         }
-        let contexts = per_lane(ctx);
-        let walks = sample_light_tree_lanes(scene, params, &contexts, &u_tree, walking);
-        let ls = sample_lights(scene, params, &contexts, (u0, u1, u2), &walks, live.bits());
-        let connecting = live & (ls.delta | M8::splat(strategy != Strategy::Bsdf));
-        if connecting.bits() != 0 {
-            let wi_local = to_local(&frame, ls.wi);
-            let f = base_eval(&base, wo, wi_local);
-            let pdf_b = base_pdf(&base, wo, wi_local);
-            let c = connect_evaluated(scene, point, ng, &ls, wi_local, f, connecting & ls.pdf.gt(zero));
-            let add = connecting & c.max_element().gt(zero);
-            if add.bits() != 0 {
-                let w = F8::select(
-                    M8::splat(strategy == Strategy::Light) | ls.delta,
-                    F8::splat(1.0),
-                    mis_weight(strategy, ls.pdf, pdf_b),
-                );
-                let depth1 = paths.depth.map(|d| d + 1);
-                let contribution = clamp_contribution(params, paths.beta * c * (w / ls.pdf), depth1);
-                paths.radiance = V3::select(add, paths.radiance + contribution, paths.radiance);
-            }
+        if resampled.bits() != 0 {
+            resample_lights(scene, params, paths, &contexts, &sv, resampled);
         }
     }
 
@@ -425,7 +621,9 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
     go = go & ((above & local_above) | (!above & !local_above));
     paths.beta = V3::select(go, paths.beta * bs.weight, paths.beta);
     go = go & paths.beta.max_element().gt(zero);
-    paths.prev_pdf = F8::select(go, bs.pdf, paths.prev_pdf);
+    // Against several light candidates MIS sees the BSDF's density scaled down.
+    let scale = F8::splat(candidate_pdf_scale(strategy, count));
+    paths.prev_pdf = F8::select(go, F8::select(resampled, bs.pdf / scale, bs.pdf), paths.prev_pdf);
     paths.prev_delta = (go & bs.delta) | (!go & paths.prev_delta);
     paths.prev_point = V3::select(go, point, paths.prev_point);
     paths.prev_normal = V3::select(go, ns, paths.prev_normal);
