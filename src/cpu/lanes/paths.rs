@@ -294,6 +294,7 @@ struct VertexLanes<'a> {
     frame: [V3; 3],
     wo: V3,
     base: &'a BaseLanes,
+    contexts: &'a [LightContext; LANES],
 }
 
 /// Weighted reservoir sampling of light candidates, lane by lane: `path_resample_lights`'s
@@ -380,50 +381,29 @@ impl Reservoir {
 /// bounces run without it, stays as it was (and quick to compile); compiled for AVX2 where the
 /// CPU has it (checked at run time, a cached load), as `trace_paths`.
 #[inline(never)]
-fn resample_lights(
-    scene: &PackedScene,
-    params: &Params,
-    paths: &mut Paths,
-    contexts: &[LightContext; LANES],
-    sv: &VertexLanes,
-    m: M8,
-) {
+fn resample_lights(scene: &PackedScene, params: &Params, paths: &mut Paths, sv: &VertexLanes, m: M8) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (checked just above).
-        return unsafe { resample_lights_avx2(scene, params, paths, contexts, sv, m) };
+        return unsafe { resample_lights_avx2(scene, params, paths, sv, m) };
     }
-    resample_lights_loop(scene, params, paths, contexts, sv, m)
+    resample_lights_loop(scene, params, paths, sv, m)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn resample_lights_avx2(
-    scene: &PackedScene,
-    params: &Params,
-    paths: &mut Paths,
-    contexts: &[LightContext; LANES],
-    sv: &VertexLanes,
-    m: M8,
-) {
-    resample_lights_loop(scene, params, paths, contexts, sv, m)
+unsafe fn resample_lights_avx2(scene: &PackedScene, params: &Params, paths: &mut Paths, sv: &VertexLanes, m: M8) {
+    resample_lights_loop(scene, params, paths, sv, m)
 }
 
 #[inline(always)]
-fn resample_lights_loop(
-    scene: &PackedScene,
-    params: &Params,
-    paths: &mut Paths,
-    contexts: &[LightContext; LANES],
-    sv: &VertexLanes,
-    m: M8,
-) {
+fn resample_lights_loop(scene: &PackedScene, params: &Params, paths: &mut Paths, sv: &VertexLanes, m: M8) {
     let strategy = path_strategy(params);
     let count = params.light_candidates;
     let mut reservoir = Reservoir::new(F8::splat(0.0));
     for k in 0..count {
         // Each lane's draws in the scalar's order: candidate 0, the picking number, the rest.
-        let ls = sample_light(scene, params, contexts, &mut paths.sampler, m);
+        let ls = sample_light(scene, params, sv.contexts, &mut paths.sampler, m);
         if k == 0 {
             reservoir.u_pick = paths.sampler.sample_1d(m);
         }
@@ -600,14 +580,14 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
     };
     if next_event_wanted(params) {
         let contexts = per_lane(|i| LightContext { point: point.lane(i), normal: ns.lane(i), reflect_only: true });
-        let sv = VertexLanes { point, ng, frame, wo, base: &base };
+        let sv = VertexLanes { point, ng, frame, wo, base: &base, contexts: &contexts };
         let single = live & !resampled;
         if single.bits() != 0 {
             let ls = sample_light(scene, params, &contexts, &mut paths.sampler, single);
             connect_light(scene, params, paths, &sv, &ls, single);
         }
         if resampled.bits() != 0 {
-            resample_lights(scene, params, paths, &contexts, &sv, resampled);
+            resample_lights(scene, params, paths, &sv, resampled);
         }
     }
 
