@@ -324,12 +324,18 @@ pub fn next_event_wanted(params: &Params) -> bool {
 /// light chosen without the BSDF rarely falls inside it (GGX α < 0.25).
 pub const GLOSSY_ROUGHNESS: f32 = 0.5;
 
-/// Has the material a glossy reflection lobe (a GGX lobe, not a Dirac one, in the base or
-/// the coat)? A function of the material alone, so that the lanes kernel can tell too.
+/// Is a GGX lobe of perceptual roughness `r` glossy (narrow, but not a Dirac one)? The lanes
+/// kernel's twin takes the same test lane by lane.
+#[inline(always)]
+pub fn glossy_lobe(r: f32) -> bool {
+    r < GLOSSY_ROUGHNESS && r * r >= DELTA_ALPHA
+}
+
+/// Has the material a glossy reflection lobe (in the base or the coat)? A function of the
+/// material alone, so that the lanes kernel can tell too.
 #[inline(always)]
 pub fn material_glossy(m: &Material) -> bool {
-    let glossy = |r: f32| r < GLOSSY_ROUGHNESS && r * r >= DELTA_ALPHA;
-    glossy(m.roughness) || (m.clearcoat > 0.0 && glossy(m.clearcoat_roughness))
+    glossy_lobe(m.roughness) || (m.clearcoat > 0.0 && glossy_lobe(m.clearcoat_roughness))
 }
 
 /// Light candidates next-event estimation resamples at a vertex of material `m`: the

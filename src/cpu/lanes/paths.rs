@@ -208,6 +208,12 @@ fn mis_weight(strategy: Strategy, pdf_f: F8, pdf_g: F8) -> F8 {
     F8::select(pdf_f.le(F8::splat(0.0)), F8::splat(0.0), w)
 }
 
+/// `glossy_lobe` in lanes.
+#[inline(always)]
+fn glossy_lobe(r: F8) -> M8 {
+    r.lt(F8::splat(GLOSSY_ROUGHNESS)) & (r * r).ge(F8::splat(DELTA_ALPHA))
+}
+
 /// `offset_ray` in lanes: `p` moved off its surface along `n` by a few ulps (a fixed step
 /// near the origin), the scalar's operations lane by lane.
 #[inline(always)]
@@ -297,9 +303,9 @@ struct VertexLanes<'a> {
     contexts: &'a [LightContext; LANES],
 }
 
-/// Weighted reservoir sampling of light candidates, lane by lane: `path_resample_lights`'s
-/// stream (each candidate weighed by its MIS weight times its target over its density, one
-/// kept in proportion to its weight), the operations lane by lane.
+/// Weighted reservoir sampling of light candidates in lanes: `path_resample_lights`'s stream
+/// (each candidate weighed by its MIS weight times its target over its density, one kept in
+/// proportion to its weight), the scalar's operations lane by lane.
 struct Reservoir {
     u_pick: F8,
     w_sum: F8,
@@ -571,10 +577,9 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
     // Next-event estimation: one light sample, or at glossy surfaces the one kept of several.
     let count = params.light_candidates;
     // `light_candidates(params, m) > 1`: a plain material has no coat, so glossy = its base's
-    // roughness (`material_glossy`), tested in lanes.
+    // lobe is (`material_glossy`).
     let resampled = if params.light_candidates > 1 && strategy != Strategy::Bsdf {
-        let r = base.roughness;
-        live & r.lt(F8::splat(GLOSSY_ROUGHNESS)) & (r * r).ge(F8::splat(DELTA_ALPHA))
+        live & glossy_lobe(base.roughness)
     } else {
         M8::splat(false)
     };
@@ -602,8 +607,11 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
     paths.beta = V3::select(go, paths.beta * bs.weight, paths.beta);
     go = go & paths.beta.max_element().gt(zero);
     // Against several light candidates MIS sees the BSDF's density scaled down.
-    let scale = F8::splat(candidate_pdf_scale(strategy, count));
-    paths.prev_pdf = F8::select(go, F8::select(resampled, bs.pdf / scale, bs.pdf), paths.prev_pdf);
+    let mut pdf = bs.pdf;
+    if resampled.bits() != 0 {
+        pdf = F8::select(resampled, bs.pdf / F8::splat(candidate_pdf_scale(strategy, count)), pdf);
+    }
+    paths.prev_pdf = F8::select(go, pdf, paths.prev_pdf);
     paths.prev_delta = (go & bs.delta) | (!go & paths.prev_delta);
     paths.prev_point = V3::select(go, point, paths.prev_point);
     paths.prev_normal = V3::select(go, ns, paths.prev_normal);
