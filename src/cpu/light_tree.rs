@@ -243,6 +243,7 @@ pub(crate) fn group_shares(
 /// and `u` rescaled into its interval: slots of no share are passed over, and the last one
 /// with a share takes the interval's rest up to 1, so that rounding never leaves `u` unchosen.
 /// With two children this is the binary walk's choice exactly.
+#[inline(always)]
 pub fn choose_child(shares: [f32; 4], u: f32) -> (usize, f32) {
     let mut last = 0;
     for (k, &s) in shares.iter().enumerate() {

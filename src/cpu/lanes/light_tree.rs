@@ -3,7 +3,8 @@
 //! the same group (all of them at the root; neighbouring paths often below it) the group's
 //! four children are tested against all of them at once, one path a SIMD lane
 //! (`group_shares_lanes`: the operations `group_importance` and `group_shares` do lane by
-//! lane, so the same shares, the same bits); a path alone at its group takes the scalar step.
+//! lane, so the same shares, the same bits); paths alone at their groups step two at a time,
+//! each one's four children in half of the lanes (`group_shares_pair`).
 
 use super::lane::{F8, M8, V3};
 use super::{LANES, lanes_of};
@@ -14,8 +15,8 @@ use crate::params::Params;
 /// Children of a light-tree group (`packed::LIGHT_TREE_WIDTH`).
 const WIDTH: usize = crate::packed::LIGHT_TREE_WIDTH as usize;
 
-/// Paths at one group from which the group is tested in lanes (fewer take the scalar step:
-/// measured, BENCHMARKS.md session 18).
+/// Paths at one group from which the group is tested in lanes (fewer step in pairs: measured,
+/// BENCHMARKS.md sessions 18 and 23).
 const SHARED_GROUP: u32 = 4;
 
 /// SSE's max and min (`light_tree::max_ps`, `min_ps`).
@@ -42,76 +43,117 @@ fn axes(f: impl Fn(usize) -> F8) -> [F8; 3] {
     [f(0), f(1), f(2)]
 }
 
+/// Light-tree children in lanes: lane j holds one child's bounds, power, cone and leaf plane,
+/// as `group_importance` has a group's child k in its lane k. The lanes may hold children of
+/// one group seen from eight paths, or of two groups seen from two paths.
+struct ChildLanes {
+    phi: F8,
+    lo: [F8; 3],
+    hi: [F8; 3],
+    axis: [F8; 3],
+    sin_o: F8,
+    cos_o: F8,
+    cos_e: F8,
+    two_sided: M8,
+    /// One-sided leaf triangles (`group_shares`' plane test), with their planes.
+    one_sided: M8,
+    plane_p0: [F8; 3],
+    plane_n: [F8; 3],
+}
+
+impl ChildLanes {
+    /// Lane j: slot `slot(j)` of group `group(j)`.
+    #[inline(always)]
+    fn gather<'a>(group: impl Fn(usize) -> &'a LightGroup, slot: impl Fn(usize) -> usize) -> ChildLanes {
+        let f = |field: fn(&LightGroup) -> &[f32; 4]| F8::from_fn(|j| field(group(j))[slot(j)]);
+        let v = |field: fn(&LightGroup) -> &[[f32; 4]; 3]| axes(|a| F8::from_fn(|j| field(group(j))[a][slot(j)]));
+        ChildLanes {
+            phi: f(|g| &g.phi),
+            lo: v(|g| &g.lo),
+            hi: v(|g| &g.hi),
+            axis: v(|g| &g.axis),
+            sin_o: f(|g| &g.sin_o),
+            cos_o: f(|g| &g.cos_o),
+            cos_e: f(|g| &g.cos_e),
+            two_sided: M8::from_fn(|j| group(j).next[slot(j)] & LIGHT_TWO_SIDED != 0),
+            one_sided: M8::from_fn(|j| group(j).one_sided[slot(j)] != 0),
+            plane_p0: v(|g| &g.plane_p0),
+            plane_n: v(|g| &g.plane_n),
+        }
+    }
+}
+
+/// `group_importance` and `group_shares`' plane test, lane by lane: the far and near
+/// importance of child lanes `c` seen from points `p` with normals `n`.
+#[inline(always)]
+fn child_importance_lanes(p: [F8; 3], n: [F8; 3], reflect_only: M8, c: &ChildLanes) -> (F8, F8) {
+    let zero = F8::splat(0.0);
+    let one = F8::splat(1.0);
+    let dot3 = |a: [F8; 3], b: [F8; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (lo, hi) = (c.lo, c.hi);
+    let pc = axes(|a| 0.5 * (lo[a] + hi[a]));
+    let half = axes(|a| 0.5 * (hi[a] - lo[a]));
+    let below = dot3(axes(|a| pc[a] - p[a]), n) + dot3(half, axes(|a| n[a].abs()));
+    let dead = c.phi.le(zero) | (reflect_only & below.le(zero));
+    let r2 = dot3(half, half);
+    let to_p = axes(|a| p[a] - pc[a]);
+    let dist2 = dot3(to_p, to_p);
+    let outside = axes(|a| p[a] - min_ps(max_ps(p[a], lo[a]), hi[a]));
+    let tiny = F8::splat(1e-20);
+    let d2_far = max_ps(max_ps(dist2, r2), tiny);
+    let d2_near = max_ps(max_ps(dot3(outside, outside), 0.25 * r2), tiny);
+    let inside = dist2.le(r2);
+    let inv_d = 1.0 / dist2.sqrt();
+    let wi = axes(|a| to_p[a] * inv_d);
+    let cos_w = dot3(c.axis, wi);
+    let cos_w = F8::select(c.two_sided, cos_w.abs(), cos_w);
+    let safe_sqrt = |x: F8| max_ps(x, zero).sqrt();
+    let cos_sub = |sa: F8, ca: F8, sb: F8, cb: F8| F8::select(ca.gt(cb), one, ca * cb + sa * sb);
+    let sin_sub = |sa: F8, ca: F8, sb: F8, cb: F8| F8::select(ca.gt(cb), zero, sa * cb - ca * sb);
+    let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
+    let sin2_b = r2 * (inv_d * inv_d);
+    let cos_b = safe_sqrt(1.0 - sin2_b);
+    let sin_b = sin2_b.sqrt();
+    let cos_x = cos_sub(sin_w, cos_w, c.sin_o, c.cos_o);
+    let sin_x = sin_sub(sin_w, cos_w, c.sin_o, c.cos_o);
+    let cos_p = cos_sub(sin_x, cos_x, sin_b, cos_b);
+    let culled = cos_p.le(c.cos_e);
+    let cos_i = dot3(wi, n).abs();
+    let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
+    let cos_pi = cos_sub(sin_i, cos_i, sin_b, cos_b);
+    let lit = c.phi * cos_p * cos_pi;
+    let (mut f, mut e) = (max_ps(lit / d2_far, zero), max_ps(lit / d2_near, zero));
+    f = F8::select(culled, zero, f);
+    e = F8::select(culled, zero, e);
+    f = F8::select(inside, c.phi / d2_far, f);
+    e = F8::select(inside, c.phi / d2_near, e);
+    f = F8::select(dead, zero, f);
+    e = F8::select(dead, zero, e);
+    if c.one_sided.bits() != 0 {
+        let side = dot3(c.plane_n, axes(|a| p[a] - c.plane_p0[a]));
+        let behind = f.gt(zero) & c.one_sided & side.le(zero);
+        f = F8::select(behind, zero, f);
+        e = F8::select(behind, zero, e);
+    }
+    (f, e)
+}
+
 /// `group_shares` of group `g` for every path in lanes: the four children's shares (lane i:
 /// path i), and the lanes at a dead end.
 #[inline(always)]
 fn group_shares_lanes(c: &Contexts, g: &LightGroup) -> ([F8; WIDTH], M8) {
     let zero = F8::splat(0.0);
-    let one = F8::splat(1.0);
     let p = [c.point.x, c.point.y, c.point.z];
     let n = [c.normal.x, c.normal.y, c.normal.z];
-    let dot3 = |a: [F8; 3], b: [F8; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let mut far = [zero; WIDTH];
     let mut near = [zero; WIDTH];
     for k in 0..WIDTH {
         if g.phi[k] <= 0.0 {
-            // No power (an empty slot): dead for every path, as the selects below make it.
+            // No power (an empty slot): dead for every path, as the selects make it.
             continue;
         }
-        // The child's constants, as `group_importance` has them in its lane k.
-        let phi = F8::splat(g.phi[k]);
-        let lo = axes(|a| F8::splat(g.lo[a][k]));
-        let hi = axes(|a| F8::splat(g.hi[a][k]));
-        let pc = axes(|a| F8::splat(0.5 * (g.lo[a][k] + g.hi[a][k])));
-        let half = axes(|a| F8::splat(0.5 * (g.hi[a][k] - g.lo[a][k])));
-        let below = dot3(axes(|a| pc[a] - p[a]), n) + dot3(half, axes(|a| n[a].abs()));
-        let dead = phi.le(zero) | (c.reflect_only & below.le(zero));
-        let r2 = dot3(half, half);
-        let to_p = axes(|a| p[a] - pc[a]);
-        let dist2 = dot3(to_p, to_p);
-        let outside = axes(|a| p[a] - min_ps(max_ps(p[a], lo[a]), hi[a]));
-        let tiny = F8::splat(1e-20);
-        let d2_far = max_ps(max_ps(dist2, r2), tiny);
-        let d2_near = max_ps(max_ps(dot3(outside, outside), 0.25 * r2), tiny);
-        let inside = dist2.le(r2);
-        let inv_d = 1.0 / dist2.sqrt();
-        let wi = axes(|a| to_p[a] * inv_d);
-        let mut cos_w = dot3(axes(|a| F8::splat(g.axis[a][k])), wi);
-        if g.next[k] & LIGHT_TWO_SIDED != 0 {
-            cos_w = cos_w.abs();
-        }
-        let safe_sqrt = |x: F8| max_ps(x, zero).sqrt();
-        let cos_sub = |sa: F8, ca: F8, sb: F8, cb: F8| F8::select(ca.gt(cb), one, ca * cb + sa * sb);
-        let sin_sub = |sa: F8, ca: F8, sb: F8, cb: F8| F8::select(ca.gt(cb), zero, sa * cb - ca * sb);
-        let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
-        let sin2_b = r2 * (inv_d * inv_d);
-        let cos_b = safe_sqrt(1.0 - sin2_b);
-        let sin_b = sin2_b.sqrt();
-        let (sin_o, cos_o) = (F8::splat(g.sin_o[k]), F8::splat(g.cos_o[k]));
-        let cos_x = cos_sub(sin_w, cos_w, sin_o, cos_o);
-        let sin_x = sin_sub(sin_w, cos_w, sin_o, cos_o);
-        let cos_p = cos_sub(sin_x, cos_x, sin_b, cos_b);
-        let culled = cos_p.le(F8::splat(g.cos_e[k]));
-        let cos_i = dot3(wi, n).abs();
-        let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
-        let cos_pi = cos_sub(sin_i, cos_i, sin_b, cos_b);
-        let lit = phi * cos_p * cos_pi;
-        let (mut f, mut e) = (max_ps(lit / d2_far, zero), max_ps(lit / d2_near, zero));
-        f = F8::select(culled, zero, f);
-        e = F8::select(culled, zero, e);
-        f = F8::select(inside, phi / d2_far, f);
-        e = F8::select(inside, phi / d2_near, e);
-        f = F8::select(dead, zero, f);
-        e = F8::select(dead, zero, e);
-        // `group_shares`' plane test of a one-sided leaf triangle.
-        if g.one_sided[k] != 0 {
-            let plane_n = axes(|a| F8::splat(g.plane_n[a][k]));
-            let side = dot3(plane_n, axes(|a| p[a] - F8::splat(g.plane_p0[a][k])));
-            let behind = f.gt(zero) & side.le(zero);
-            f = F8::select(behind, zero, f);
-            e = F8::select(behind, zero, e);
-        }
-        (far[k], near[k]) = (f, e);
+        let child = ChildLanes::gather(|_| g, |_| k);
+        (far[k], near[k]) = child_importance_lanes(p, n, c.reflect_only, &child);
     }
     let total_far = far[0] + far[1] + far[2] + far[3];
     let total_near = near[0] + near[1] + near[2] + near[3];
@@ -120,6 +162,61 @@ fn group_shares_lanes(c: &Contexts, g: &LightGroup) -> ([F8; WIDTH], M8) {
     let share = |k: usize| 0.5 * (far[k] / total_far + near[k] / total_near);
     let shares = [share(0), share(1), share(2), share(3)];
     (shares, end)
+}
+
+/// `group_shares` of two paths at once, each at its own group: path a's four children in
+/// lanes 0–3, path b's in lanes 4–7 (half the work of two scalar steps).
+#[inline(always)]
+fn group_shares_pair(a: (&LightContext, &LightGroup), b: (&LightContext, &LightGroup)) -> [Option<[f32; 4]>; 2] {
+    let half = |j: usize| j >= WIDTH;
+    let ctx = |j: usize| if half(j) { b.0 } else { a.0 };
+    let p = axes(|k| F8::from_fn(|j| ctx(j).point[k]));
+    let n = axes(|k| F8::from_fn(|j| ctx(j).normal[k]));
+    let reflect_only = M8::from_fn(|j| ctx(j).reflect_only);
+    let child = ChildLanes::gather(|j| if half(j) { b.1 } else { a.1 }, |j| j % WIDTH);
+    let (far, near) = child_importance_lanes(p, n, reflect_only, &child);
+    // Each path's totals in slot order, as the scalar step adds them.
+    let total = |x: F8, h: usize| ((x.0[h] + x.0[h + 1]) + x.0[h + 2]) + x.0[h + 3];
+    let (ta, tb) = ((total(far, 0), total(near, 0)), (total(far, WIDTH), total(near, WIDTH)));
+    let total_far = F8::from_fn(|j| if half(j) { tb.0 } else { ta.0 });
+    let total_near = F8::from_fn(|j| if half(j) { tb.1 } else { ta.1 });
+    let shares = 0.5 * (far / total_far + near / total_near);
+    let of = |h: usize, t: f32| {
+        // NaN or ≤ 0: a dead end.
+        (t > 0.0).then(|| [shares.0[h], shares.0[h + 1], shares.0[h + 2], shares.0[h + 3]])
+    };
+    [of(0, ta.0), of(WIDTH, tb.0)]
+}
+
+/// The walks of a packet's paths, each where its own `sample_light_tree` would be.
+struct Walks {
+    group: [u32; LANES],
+    u: [f32; LANES],
+    pmf: [f32; LANES],
+    walking: u32,
+    out: [(u32, f32); LANES],
+}
+
+impl Walks {
+    /// Path i's step from its group with the children's `shares` (None: a dead end).
+    #[inline(always)]
+    fn step(&mut self, g: &LightGroup, i: usize, shares: Option<[f32; 4]>) {
+        let Some(shares) = shares else {
+            self.out[i] = (0, 0.0);
+            self.walking &= !(1 << i);
+            return;
+        };
+        let (slot, rescaled) = choose_child(shares, self.u[i]);
+        self.u[i] = rescaled;
+        self.pmf[i] *= shares[slot];
+        let next = g.next[slot];
+        if next & LIGHT_LEAF != 0 {
+            self.out[i] = (next & !(LIGHT_LEAF | LIGHT_TWO_SIDED), self.pmf[i]);
+            self.walking &= !(1 << i);
+        } else {
+            self.group[i] = next & !LIGHT_TWO_SIDED;
+        }
+    }
 }
 
 /// `sample_light_tree` from `ctx[i]` with number `u[i]` for the lanes `i` of `mask`:
@@ -148,42 +245,35 @@ pub fn sample_light_tree_lanes(
         normal: V3::from_fn(|i| ctx[i].normal),
         reflect_only: M8::from_fn(|i| ctx[i].reflect_only),
     };
-    let mut group = [0u32; LANES];
-    let mut u = *u;
-    let mut pmf = [1.0f32; LANES];
-    let mut walking = mask;
-    while walking != 0 {
+    let mut w = Walks { group: [0; LANES], u: *u, pmf: [1.0; LANES], walking: mask, out };
+    while w.walking != 0 {
         // The paths standing where the first walking one stands.
-        let g = group[walking.trailing_zeros() as usize];
+        let first = w.walking.trailing_zeros() as usize;
+        let g = &scene.light_groups[w.group[first] as usize];
         let mut here = 0u32;
-        for i in lanes_of(walking) {
-            if group[i] == g {
+        for i in lanes_of(w.walking) {
+            if w.group[i] == w.group[first] {
                 here |= 1 << i;
             }
         }
-        let node = &scene.light_groups[g as usize];
-        let in_lanes = if here.count_ones() >= SHARED_GROUP { Some(group_shares_lanes(&contexts, node)) } else { None };
-        for i in lanes_of(here) {
-            let shares = match &in_lanes {
-                Some((s, end)) => (!end.lane(i)).then(|| [s[0].0[i], s[1].0[i], s[2].0[i], s[3].0[i]]),
-                None => group_shares(scene, params, &ctx[i], node),
-            };
-            let Some(shares) = shares else {
-                out[i] = (0, 0.0);
-                walking &= !(1 << i);
-                continue;
-            };
-            let (slot, rescaled) = choose_child(shares, u[i]);
-            u[i] = rescaled;
-            pmf[i] *= shares[slot];
-            let next = node.next[slot];
-            if next & LIGHT_LEAF != 0 {
-                out[i] = (next & !(LIGHT_LEAF | LIGHT_TWO_SIDED), pmf[i]);
-                walking &= !(1 << i);
-            } else {
-                group[i] = next & !LIGHT_TWO_SIDED;
+        if here.count_ones() >= SHARED_GROUP {
+            let (s, end) = group_shares_lanes(&contexts, g);
+            for i in lanes_of(here) {
+                w.step(g, i, (!end.lane(i)).then(|| [s[0].0[i], s[1].0[i], s[2].0[i], s[3].0[i]]));
             }
+            continue;
         }
+        // Fewer paths here: this one steps with the next walking path, wherever that stands.
+        let rest = w.walking & !(1 << first);
+        if rest == 0 {
+            w.step(g, first, group_shares(scene, params, &ctx[first], g));
+            continue;
+        }
+        let second = rest.trailing_zeros() as usize;
+        let g2 = &scene.light_groups[w.group[second] as usize];
+        let [a, b] = group_shares_pair((&ctx[first], g), (&ctx[second], g2));
+        w.step(g, first, a);
+        w.step(g2, second, b);
     }
-    out
+    w.out
 }
