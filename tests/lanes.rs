@@ -91,3 +91,59 @@ fn packets_of_paths_render_the_reference_films_bit_for_bit() {
         assert_eq!(lanes.len(), reference.len(), "{name}: film sizes");
     }
 }
+
+/// The light tree's choice in lanes (`choose_child_lanes`, eight walks at once) is the scalar
+/// `choose_child` lane by lane: same child, same rescaled number, bit for bit — over random
+/// shares with empty, NaN and negative slots, shares that do not sum to 1, and numbers at 0
+/// and just below 1.
+#[test]
+fn choosing_a_child_in_lanes_matches_the_scalar_choice() {
+    use veach::cpu::lanes::lane::F8;
+    use veach::cpu::lanes::light_tree::choose_child_lanes;
+    use veach::cpu::light_tree::choose_child;
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let mut kinds = [0usize; 4];
+    for round in 0..50_000 {
+        let mut shares = [[0.0f32; 8]; 4];
+        let mut u = [0.0f32; 8];
+        for j in 0..8 {
+            let mut raw = [0.0f32; 4];
+            for s in raw.iter_mut() {
+                *s = match (next() * 10.0) as u32 {
+                    0 | 1 => 0.0,
+                    2 => f32::NAN,
+                    3 => -next(),
+                    _ => next(),
+                };
+            }
+            let total: f32 = raw.iter().filter(|s| **s > 0.0).sum();
+            // Mostly normalised shares, as the walk makes them; some not.
+            let scale = if round % 7 == 0 || total <= 0.0 { 1.0 } else { 1.0 / total };
+            for k in 0..4 {
+                shares[k][j] = raw[k] * scale;
+            }
+            u[j] = match round % 11 {
+                0 => 0.0,
+                1 => 1.0 - f32::EPSILON / 2.0,
+                _ => next(),
+            };
+        }
+        let lanes = [F8(shares[0]), F8(shares[1]), F8(shares[2]), F8(shares[3])];
+        let (slot, rescaled) = choose_child_lanes(&lanes, F8(u));
+        for j in 0..8 {
+            let one = [shares[0][j], shares[1][j], shares[2][j], shares[3][j]];
+            let (k, r) = choose_child(one, u[j]);
+            assert_eq!(slot[j], k, "shares {one:?}, u {}: child", u[j]);
+            assert_eq!(rescaled.0[j].to_bits(), r.to_bits(), "shares {one:?}, u {}: rescaled number", u[j]);
+            kinds[k] += 1;
+        }
+    }
+    // Every child was chosen often (the test saw each branch of the choice).
+    assert!(kinds.iter().all(|&n| n > 10_000), "children chosen {kinds:?}");
+}

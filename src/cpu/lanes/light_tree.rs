@@ -3,11 +3,15 @@
 //! the same group (all of them at the root; neighbouring paths often below it) the group's
 //! four children are tested against all of them at once, one path a SIMD lane
 //! (`group_shares_lanes`: the operations `group_importance` and `group_shares` do lane by
-//! lane, so the same shares, the same bits); paths alone at their groups step two at a time,
-//! each one's four children in half of the lanes (`group_shares_pair`).
+//! lane, so the same shares, the same bits) and the paths there choose their children side by
+//! side (`choose_child_lanes`); paths alone at their groups step two at a time, each one's four
+//! children in half of the lanes (`group_shares_pair`). A vertex's light candidates walk
+//! together (`sample_light_tree_candidates`): a path's candidates at the same group step from
+//! one evaluation of its children.
 
 use super::lane::{F8, M8, V3};
 use super::{LANES, lanes_of};
+use crate::cpu::common::ONE_MINUS_EPSILON;
 use crate::cpu::light_tree::{LightContext, child_importance, choose_child, group_shares, load_light_node};
 use crate::packed::{LIGHT_LEAF, LIGHT_TWO_SIDED, LightGroup, PackedScene};
 use crate::params::Params;
@@ -188,36 +192,121 @@ fn group_shares_pair(a: (&LightContext, &LightGroup), b: (&LightContext, &LightG
     [of(0, ta.0), of(WIDTH, tb.0)]
 }
 
-/// The walks of a packet's paths, each where its own `sample_light_tree` would be.
-struct Walks {
-    group: [u32; LANES],
-    u: [f32; LANES],
-    pmf: [f32; LANES],
-    walking: u32,
-    out: [(u32, f32); LANES],
+/// `choose_child` for eight walks at once (lane j: shares `s[k].0[j]`, number `u.0[j]`): the
+/// scalar's comparisons and roundings lane by lane, in its order, so the same child and the
+/// same rescaled number (no branch on `u`, which no predictor guesses).
+#[inline(always)]
+pub fn choose_child_lanes(s: &[F8; WIDTH], u: F8) -> ([usize; LANES], F8) {
+    let (zero, top) = (F8::splat(0.0), F8::splat(ONE_MINUS_EPSILON));
+    let child = |k: usize| F8::splat(k as f32);
+    // NaN or ≤ 0: no share.
+    let valid = [s[0].gt(zero), s[1].gt(zero), s[2].gt(zero), s[3].gt(zero)];
+    let mut last = zero;
+    for (k, &v) in valid.iter().enumerate().skip(1) {
+        last = F8::select(v, child(k), last);
+    }
+    // Nothing chosen below: (last, u), as the scalar's fall-through.
+    let (mut slot, mut out) = (last, u);
+    let mut open = M8::splat(true);
+    let mut below = zero;
+    for k in 0..WIDTH {
+        let is_last = last.eq(child(k));
+        let take_last = open & valid[k] & is_last;
+        let take_inside = open & valid[k] & !is_last & u.lt(below + s[k]);
+        let r_last = ((u - below) / (1.0 - below)).min_num(top);
+        let r_inside = ((u - below) / s[k]).min_num(top);
+        out = F8::select(take_last, r_last, F8::select(take_inside, r_inside, out));
+        let taken = take_last | take_inside;
+        slot = F8::select(taken, child(k), slot);
+        open = open & !taken;
+        below = F8::select(valid[k], below + s[k], below);
+    }
+    (std::array::from_fn(|j| slot.0[j] as usize), out)
 }
 
-impl Walks {
-    /// Path i's step from its group with the children's `shares` (None: a dead end).
+/// The walks of a packet's paths, each where its own `sample_light_tree` would be: `N` walks,
+/// walk e of path `e % LANES` (several walks per path when a vertex draws several light
+/// candidates).
+struct Walks<const N: usize> {
+    group: [u32; N],
+    u: [f32; N],
+    pmf: [f32; N],
+    walking: u32,
+    out: [(u32, f32); N],
+}
+
+impl<const N: usize> Walks<N> {
+    /// Walk e's step from its group with the children's `shares` (None: a dead end).
     #[inline(always)]
-    fn step(&mut self, g: &LightGroup, i: usize, shares: Option<[f32; 4]>) {
+    fn step(&mut self, g: &LightGroup, e: usize, shares: Option<[f32; 4]>) {
         let Some(shares) = shares else {
-            self.out[i] = (0, 0.0);
-            self.walking &= !(1 << i);
+            self.end(e);
             return;
         };
-        let (slot, rescaled) = choose_child(shares, self.u[i]);
-        self.u[i] = rescaled;
-        self.pmf[i] *= shares[slot];
+        let (slot, rescaled) = choose_child(shares, self.u[e]);
+        self.take(g, e, slot, rescaled, shares[slot]);
+    }
+
+    /// Walk e at a dead end.
+    #[inline(always)]
+    fn end(&mut self, e: usize) {
+        self.out[e] = (0, 0.0);
+        self.walking &= !(1 << e);
+    }
+
+    /// Walk e goes on to child `slot` of `g`, chosen with probability `share`, with its
+    /// number rescaled to `rescaled`.
+    #[inline(always)]
+    fn take(&mut self, g: &LightGroup, e: usize, slot: usize, rescaled: f32, share: f32) {
+        self.u[e] = rescaled;
+        self.pmf[e] *= share;
         let next = g.next[slot];
         if next & LIGHT_LEAF != 0 {
-            self.out[i] = (next & !(LIGHT_LEAF | LIGHT_TWO_SIDED), self.pmf[i]);
-            self.walking &= !(1 << i);
+            self.out[e] = (next & !(LIGHT_LEAF | LIGHT_TWO_SIDED), self.pmf[e]);
+            self.walking &= !(1 << e);
         } else {
-            self.group[i] = next & !LIGHT_TWO_SIDED;
+            self.group[e] = next & !LIGHT_TWO_SIDED;
         }
     }
+
+    /// The walks among `mask` that stand at group `group` (a loop over every walk, which the
+    /// compiler makes a few vector compares).
+    #[inline(always)]
+    fn at(&self, mask: u32, group: u32) -> u32 {
+        let mut here = 0u32;
+        for (e, &g) in self.group.iter().enumerate() {
+            here |= u32::from(g == group) << e;
+        }
+        here & mask
+    }
 }
+
+/// The walks (bits) of path `i` among `N` walks.
+#[inline(always)]
+fn walks_of_path<const N: usize>(i: usize) -> u32 {
+    let mut bits = 0u32;
+    let mut e = i;
+    while e < N {
+        bits |= 1 << e;
+        e += LANES;
+    }
+    bits
+}
+
+/// The paths (bits) with a walk among the walks `walks`.
+#[inline(always)]
+fn paths_of<const N: usize>(walks: u32) -> u32 {
+    let mut paths = 0u32;
+    let mut shift = 0;
+    while shift < N {
+        paths |= walks >> shift;
+        shift += LANES;
+    }
+    paths & ((1 << LANES) - 1)
+}
+
+/// Most light candidates walked together (`Walks`' bits are one u32).
+pub const MAX_CANDIDATES: usize = 32 / LANES;
 
 /// `sample_light_tree` from `ctx[i]` with number `u[i]` for the lanes `i` of `mask`:
 /// (emitter, probability) per lane, (0, 0) elsewhere.
@@ -229,14 +318,31 @@ pub fn sample_light_tree_lanes(
     u: &[f32; LANES],
     mask: u32,
 ) -> [(u32, f32); LANES] {
-    let mut out = [(0u32, 0.0f32); LANES];
+    sample_light_tree_candidates::<LANES>(scene, params, ctx, u, mask)
+}
+
+/// `sample_light_tree` for `N / LANES` light candidates of each path at once: walk e from
+/// `ctx[e % LANES]` with number `u[e]`, for the walks e of `mask`. A path's candidates that
+/// stand at the same group take their steps from one evaluation of its children (the same
+/// point, so the same shares), and more walks side by side fill more lanes.
+#[inline(always)]
+pub fn sample_light_tree_candidates<const N: usize>(
+    scene: &PackedScene,
+    params: &Params,
+    ctx: &[LightContext; LANES],
+    u: &[f32; N],
+    mask: u32,
+) -> [(u32, f32); N] {
+    const { assert!(N.is_multiple_of(LANES) && N <= 32) };
+    let mut out = [(0u32, 0.0f32); N];
     if mask == 0 {
         return out;
     }
     let root = load_light_node(scene, params, 0);
     if root.leaf {
-        for i in lanes_of(mask) {
-            out[i] = (root.index, if child_importance(scene, params, &ctx[i], &root).x > 0.0 { 1.0 } else { 0.0 });
+        for e in lanes_of(mask) {
+            let i = e % LANES;
+            out[e] = (root.index, if child_importance(scene, params, &ctx[i], &root).x > 0.0 { 1.0 } else { 0.0 });
         }
         return out;
     }
@@ -245,35 +351,55 @@ pub fn sample_light_tree_lanes(
         normal: V3::from_fn(|i| ctx[i].normal),
         reflect_only: M8::from_fn(|i| ctx[i].reflect_only),
     };
-    let mut w = Walks { group: [0; LANES], u: *u, pmf: [1.0; LANES], walking: mask, out };
+    let mut w = Walks { group: [0; N], u: *u, pmf: [1.0; N], walking: mask, out };
     while w.walking != 0 {
-        // The paths standing where the first walking one stands.
+        // The walks standing where the first walking one stands, and their paths.
         let first = w.walking.trailing_zeros() as usize;
         let g = &scene.light_groups[w.group[first] as usize];
-        let mut here = 0u32;
-        for i in lanes_of(w.walking) {
-            if w.group[i] == w.group[first] {
-                here |= 1 << i;
-            }
-        }
-        if here.count_ones() >= SHARED_GROUP {
+        let here = w.at(w.walking, w.group[first]);
+        let paths_here = paths_of::<N>(here);
+        if paths_here.count_ones() >= SHARED_GROUP {
             let (s, end) = group_shares_lanes(&contexts, g);
-            for i in lanes_of(here) {
-                w.step(g, i, (!end.lane(i)).then(|| [s[0].0[i], s[1].0[i], s[2].0[i], s[3].0[i]]));
+            // Walks 8c..8c + 8 are one walk of each path, in the shares' lanes: they choose
+            // side by side.
+            for c in (0..N).step_by(LANES) {
+                let walks = (here >> c) & ((1 << LANES) - 1);
+                if walks == 0 {
+                    continue;
+                }
+                let (slot, rescaled) = choose_child_lanes(&s, F8::from_fn(|j| w.u[c + j]));
+                for j in lanes_of(walks) {
+                    if end.lane(j) {
+                        w.end(c + j);
+                    } else {
+                        w.take(g, c + j, slot[j], rescaled.0[j], s[slot[j]].0[j]);
+                    }
+                }
             }
             continue;
         }
-        // Fewer paths here: this one steps with the next walking path, wherever that stands.
-        let rest = w.walking & !(1 << first);
+        // Fewer paths here: the first walk's path steps (all its walks at this group) with
+        // the next walk elsewhere or of another path, wherever that stands.
+        let (a, a_walks) = (first % LANES, here & walks_of_path::<N>(first % LANES));
+        let rest = w.walking & !a_walks;
         if rest == 0 {
-            w.step(g, first, group_shares(scene, params, &ctx[first], g));
+            let shares = group_shares(scene, params, &ctx[a], g);
+            for e in lanes_of(a_walks) {
+                w.step(g, e, shares);
+            }
             continue;
         }
         let second = rest.trailing_zeros() as usize;
+        let b = second % LANES;
         let g2 = &scene.light_groups[w.group[second] as usize];
-        let [a, b] = group_shares_pair((&ctx[first], g), (&ctx[second], g2));
-        w.step(g, first, a);
-        w.step(g2, second, b);
+        let b_walks = w.at(rest & walks_of_path::<N>(b), w.group[second]);
+        let [sa, sb] = group_shares_pair((&ctx[a], g), (&ctx[b], g2));
+        for e in lanes_of(a_walks) {
+            w.step(g, e, sa);
+        }
+        for e in lanes_of(b_walks) {
+            w.step(g2, e, sb);
+        }
     }
     w.out
 }

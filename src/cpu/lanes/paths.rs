@@ -9,7 +9,7 @@
 
 use super::bsdf::{BaseLanes, base_eval, base_pdf, base_sample, is_plain};
 use super::lane::{F8, M8, U8, V3, per_lane};
-use super::light_tree::sample_light_tree_lanes;
+use super::light_tree::{MAX_CANDIDATES, sample_light_tree_candidates, sample_light_tree_lanes};
 use super::lights::{LightSampleLanes, sample_lights};
 use super::sampler::SamplerLanes;
 use super::{LANES, lanes_of};
@@ -281,6 +281,14 @@ fn sample_light(
 ) -> LightSampleLanes {
     let u0 = sampler.sample_1d(m);
     let (u1, u2) = sampler.sample_2d(m);
+    let (u_tree, walking) = tree_numbers(params, u0, m);
+    let walks = sample_light_tree_lanes(scene, params, contexts, &u_tree, walking);
+    sample_lights(scene, params, contexts, (u0, u1, u2), &walks, m.bits())
+}
+
+/// `tree_u` of the first numbers `u0` in the lanes of `m`, and the lanes that walk the tree.
+#[inline(always)]
+fn tree_numbers(params: &Params, u0: F8, m: M8) -> ([f32; LANES], u32) {
     let mut walking = 0u32;
     let mut u_tree = [0.0f32; LANES];
     for i in lanes_of(m.bits()) {
@@ -289,8 +297,7 @@ fn sample_light(
             walking |= 1 << i;
         }
     }
-    let walks = sample_light_tree_lanes(scene, params, contexts, &u_tree, walking);
-    sample_lights(scene, params, contexts, (u0, u1, u2), &walks, m.bits())
+    (u_tree, walking)
 }
 
 /// The surface vertex of a packet's plain lanes, as next-event estimation reads it.
@@ -406,14 +413,37 @@ unsafe fn resample_lights_avx2(scene: &PackedScene, params: &Params, paths: &mut
 fn resample_lights_loop(scene: &PackedScene, params: &Params, paths: &mut Paths, sv: &VertexLanes, m: M8) {
     let strategy = path_strategy(params);
     let count = params.light_candidates;
-    let mut reservoir = Reservoir::new(F8::splat(0.0));
-    for k in 0..count {
-        // Each lane's draws in the scalar's order: candidate 0, the picking number, the rest.
-        let ls = sample_light(scene, params, sv.contexts, &mut paths.sampler, m);
-        if k == 0 {
-            reservoir.u_pick = paths.sampler.sample_1d(m);
+    let zero = F8::splat(0.0);
+    let mut reservoir = Reservoir::new(zero);
+    // Up to MAX_CANDIDATES candidates at a time: their numbers first, then their tree walks
+    // together (a path's candidates share the steps they take from the same groups), then
+    // their samples, streamed in order.
+    let mut first = 0;
+    while first < count {
+        let batch = ((count - first) as usize).min(MAX_CANDIDATES);
+        let mut draws = [(zero, zero, zero); MAX_CANDIDATES];
+        let mut u_tree = [0.0f32; MAX_CANDIDATES * LANES];
+        let mut walking = 0u32;
+        for (j, draw) in draws.iter_mut().enumerate().take(batch) {
+            // Each lane's draws in the scalar's order: candidate 0, the picking number, the rest.
+            let u0 = paths.sampler.sample_1d(m);
+            let (u1, u2) = paths.sampler.sample_2d(m);
+            if first == 0 && j == 0 {
+                reservoir.u_pick = paths.sampler.sample_1d(m);
+            }
+            *draw = (u0, u1, u2);
+            let (u, walks) = tree_numbers(params, u0, m);
+            u_tree[j * LANES..(j + 1) * LANES].copy_from_slice(&u);
+            walking |= walks << (j * LANES);
         }
-        reservoir.stream(strategy, sv, &ls, count, m);
+        let walks = sample_light_tree_candidates(scene, params, sv.contexts, &u_tree, walking);
+        for (j, &draw) in draws.iter().enumerate().take(batch) {
+            let mut of_candidate = [(0u32, 0.0f32); LANES];
+            of_candidate.copy_from_slice(&walks[j * LANES..(j + 1) * LANES]);
+            let ls = sample_lights(scene, params, sv.contexts, draw, &of_candidate, m.bits());
+            reservoir.stream(strategy, sv, &ls, count, m);
+        }
+        first += batch as u32;
     }
     reservoir.connect(scene, params, paths, sv);
 }
