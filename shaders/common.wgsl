@@ -79,6 +79,10 @@ const LIGHT_NODE_ROWS: u32 = 3u;
 const LIGHT_TREE_WIDTH: u32 = 4u;
 const LIGHT_LEAF: u32 = 0x80000000u;
 const LIGHT_TWO_SIDED: u32 = 0x40000000u;
+const LIGHT_CLUSTER: u32 = 0x20000000u;
+const LIGHT_PLANAR: u32 = 0x10000000u;
+const LIGHT_INDEX_MASK: u32 = 0x0fffffffu;
+const CLUSTER_LAST: u32 = 0x80000000u;
 
 // Per-triangle vertex attributes: octahedral normals and tangents, TEXCOORD_0.
 struct Attributes {

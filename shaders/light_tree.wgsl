@@ -23,10 +23,13 @@ struct LightNode {
     cos_o: f32,
     sin_o: f32,
     cos_e: f32,
-    // The first child (interior) or the emitter (leaf).
+    // The first child (interior), the emitter (leaf) or a cluster's first entry.
     index: u32,
     leaf: bool,
     two_sided: bool,
+    // A leaf of several emitters, in one plane when `planar`.
+    cluster: bool,
+    planar: bool,
 }
 
 
@@ -37,8 +40,9 @@ fn load_light_node(node: u32) -> LightNode {
     let r2 = lights[base + 2u];
     return LightNode(
         bitcast<vec3<f32>>(r0.xyz), bitcast<f32>(r0.w), bitcast<vec3<f32>>(r1.xyz), oct_decode(r1.w),
-        bitcast<f32>(r2.x), bitcast<f32>(r2.w), bitcast<f32>(r2.y), r2.z & ~(LIGHT_LEAF | LIGHT_TWO_SIDED),
-        (r2.z & LIGHT_LEAF) != 0u, (r2.z & LIGHT_TWO_SIDED) != 0u
+        bitcast<f32>(r2.x), bitcast<f32>(r2.w), bitcast<f32>(r2.y), r2.z & LIGHT_INDEX_MASK,
+        (r2.z & LIGHT_LEAF) != 0u, (r2.z & LIGHT_TWO_SIDED) != 0u, (r2.z & LIGHT_CLUSTER) != 0u,
+        (r2.z & LIGHT_PLANAR) != 0u
     );
 }
 
@@ -100,18 +104,84 @@ fn node_importance(ctx: LightContext, node: LightNode) -> vec2<f32> {
     return max(node.phi * cos_p * cos_pi / d2, vec2<f32>(0.0));
 }
 
-// A child's importances in the walk: a leaf holding a one-sided triangle is also tested
-// against the triangle's own plane, so a point behind it (even inside its bounding sphere,
-// where the cone test cannot tell) gets probability 0.
+// A child's importances in the walk: a leaf holding a one-sided triangle (or a cluster of
+// them in one plane) is also tested against the triangle's own plane, so a point behind it
+// (even inside its bounding sphere, where the cone test cannot tell) gets probability 0.
 fn child_importance(ctx: LightContext, node: LightNode) -> vec2<f32> {
     let importance = node_importance(ctx, node);
-    if (importance.x > 0.0 && node.leaf && !node.two_sided && node.index < params.light_count) {
-        let tri = load_triangle(lights[node.index].x);
+    var emitter = node.index;
+    if (node.cluster) {
+        emitter = cluster_entry(node.index).emitter;
+    }
+    if (importance.x > 0.0 && node.leaf && !node.two_sided && (!node.cluster || node.planar)
+        && emitter < params.light_count) {
+        let tri = load_triangle(lights[emitter].x);
         if (dot(cross(tri.e1, tri.e2), ctx.point - tri.p0) <= 0.0) {
             return vec2<f32>(0.0);
         }
     }
     return importance;
+}
+
+struct ClusterEntry {
+    emitter: u32,
+    // Its probability in the cluster.
+    p: f32,
+    last: bool,
+}
+
+// Entry k of the clusters' list, two a row from the trails' first row.
+fn cluster_entry(k: u32) -> ClusterEntry {
+    let row = lights[params.trail_base + k / 2u];
+    let pair = select(row.xy, row.zw, (k & 1u) != 0u);
+    return ClusterEntry(pair.x & ~CLUSTER_LAST, bitcast<f32>(pair.y), (pair.x & CLUSTER_LAST) != 0u);
+}
+
+// The emitter `u` chooses in the cluster from entry `first` (by power: the entries' stored
+// probabilities; the last takes the rest up to 1), and that probability.
+fn choose_in_cluster(first: u32, u: f32) -> TreeChoice {
+    var below = 0.0;
+    var k = first;
+    loop {
+        let e = cluster_entry(k);
+        if (e.last || u < below + e.p) {
+            return TreeChoice(e.emitter, e.p);
+        }
+        below += e.p;
+        k++;
+    }
+    return TreeChoice(0u, 0.0);
+}
+
+// The probability that `choose_in_cluster` chooses `emitter` in the cluster from `first`.
+fn cluster_pmf(first: u32, emitter: u32) -> f32 {
+    var k = first;
+    loop {
+        let e = cluster_entry(k);
+        if (e.emitter == emitter) {
+            return e.p;
+        }
+        if (e.last) {
+            return 0.0;
+        }
+        k++;
+    }
+    return 0.0;
+}
+
+// A leaf's emitter and its probability there: its own, or one of its cluster's chosen by u.
+fn leaf_emitter(index: u32, cluster: bool, u: f32) -> TreeChoice {
+    if (cluster) {
+        return choose_in_cluster(index, u);
+    }
+    return TreeChoice(index, 1.0);
+}
+
+fn leaf_pmf(index: u32, cluster: bool, emitter: u32) -> f32 {
+    if (cluster) {
+        return cluster_pmf(index, emitter);
+    }
+    return 1.0;
 }
 
 // The mean of the far and the near estimates' shares.
@@ -132,6 +202,7 @@ struct Children {
     share: array<f32, 4>,
     index: array<u32, 4>,
     leaf: array<bool, 4>,
+    cluster: array<bool, 4>,
     ok: bool,
 }
 
@@ -147,6 +218,7 @@ fn children(ctx: LightContext, first: u32) -> Children {
         near[k] = i.y;
         ch.index[k] = c.index;
         ch.leaf[k] = c.leaf;
+        ch.cluster[k] = c.cluster;
         total += i;
     }
     for (var k = 0u; k < LIGHT_TREE_WIDTH; k++) {
@@ -191,7 +263,10 @@ fn choose_child(share: array<f32, 4>, u: f32) -> Choice {
 fn sample_light_tree(ctx: LightContext, u_in: f32) -> TreeChoice {
     let root = load_light_node(0u);
     if (root.leaf) {
-        return TreeChoice(root.index, select(0.0, 1.0, child_importance(ctx, root).x > 0.0));
+        if (child_importance(ctx, root).x > 0.0) {
+            return leaf_emitter(root.index, root.cluster, u_in);
+        }
+        return TreeChoice(root.index, 0.0);
     }
     var first = root.index;
     var u = u_in;
@@ -205,7 +280,8 @@ fn sample_light_tree(ctx: LightContext, u_in: f32) -> TreeChoice {
         u = choice.u;
         pmf *= ch.share[choice.slot];
         if (ch.leaf[choice.slot]) {
-            return TreeChoice(ch.index[choice.slot], pmf);
+            let chosen = leaf_emitter(ch.index[choice.slot], ch.cluster[choice.slot], u);
+            return TreeChoice(chosen.emitter, pmf * chosen.pmf);
         }
         first = ch.index[choice.slot];
     }
@@ -216,7 +292,7 @@ fn sample_light_tree(ctx: LightContext, u_in: f32) -> TreeChoice {
 fn light_tree_pmf(ctx: LightContext, emitter: u32) -> f32 {
     let root = load_light_node(0u);
     if (root.leaf) {
-        return select(0.0, 1.0, child_importance(ctx, root).x > 0.0);
+        return select(0.0, leaf_pmf(root.index, root.cluster, emitter), child_importance(ctx, root).x > 0.0);
     }
     var trail = lights[params.trail_base + emitter / 4u][emitter % 4u];
     var first = root.index;
@@ -229,7 +305,7 @@ fn light_tree_pmf(ctx: LightContext, emitter: u32) -> f32 {
         let slot = trail & 3u;
         pmf *= ch.share[slot];
         if (ch.leaf[slot]) {
-            return pmf;
+            return pmf * leaf_pmf(ch.index[slot], ch.cluster[slot], emitter);
         }
         first = ch.index[slot];
         trail = trail >> 2u;

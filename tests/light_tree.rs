@@ -212,6 +212,114 @@ fn a_point_behind_a_one_sided_emitter_never_chooses_it() {
     assert!((upper - 1.0).abs() < 1e-6, "{pmf:?}");
 }
 
+/// A round lamp (a UV sphere of 1 024 triangles, radius 0.4) over a floor, and a flat
+/// 4×4-grid lamp beside it: the tree's leaves are clusters of emitters (curved ones and ones
+/// in one plane), chosen inside by power.
+fn lamps_in_clusters(dir: &std::path::Path) -> PathBuf {
+    let mut b = GltfBuilder::new(dir, "clusters");
+    let floor_m = b.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1]}}));
+    let floor = b.mesh(&MeshData::quad(-5.0, -5.0, 5.0, 5.0, 0.0, MeshData::UPRIGHT), floor_m);
+    b.node(json!({"mesh": floor}));
+    let lamp = b.material(json!({"emissiveFactor": [4, 3, 2]}));
+    let (rings, segments) = (16u32, 32u32);
+    let mut sphere = MeshData::default();
+    for i in 0..=rings {
+        let theta = std::f32::consts::PI * i as f32 / rings as f32;
+        for j in 0..=segments {
+            let phi = 2.0 * std::f32::consts::PI * j as f32 / segments as f32;
+            let n = [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()];
+            sphere.positions.push(n.map(|c| 0.4 * c));
+            sphere.normals.push(n);
+            sphere.uvs.push([0.0, 0.0]);
+        }
+    }
+    for i in 0..rings {
+        for j in 0..segments {
+            let (k, w) = (i * (segments + 1) + j, segments + 1);
+            // Outward winding (counter-clockwise seen from outside).
+            sphere.indices.extend([k, k + w, k + w + 1, k, k + w + 1, k + 1]);
+        }
+    }
+    let round = b.mesh(&sphere, lamp);
+    b.node(json!({"mesh": round, "translation": [0.0, 0.0, 1.2]}));
+    let mut grid = MeshData::default();
+    for j in 0..=4 {
+        for i in 0..=4 {
+            grid.positions.push([-0.3 + 0.15 * i as f32, -0.3 + 0.15 * j as f32, 0.0]);
+            grid.normals.push([0.0, 0.0, -1.0]);
+            grid.uvs.push([0.0, 0.0]);
+        }
+    }
+    for j in 0..4 {
+        for i in 0..4 {
+            let k = j * 5 + i;
+            // Facing down (−z).
+            grid.indices.extend([k, k + 6, k + 1, k, k + 5, k + 6]);
+        }
+    }
+    let flat = b.mesh(&grid, lamp);
+    b.node(json!({"mesh": flat, "translation": [1.5, 0.5, 1.0]}));
+    b.camera(0.8, 1.0, [0.0, 0.0, 6.0]);
+    b.write()
+}
+
+#[test]
+fn emitters_in_clusters_are_drawn_as_often_as_their_probabilities() {
+    let d = tempfile::tempdir().unwrap();
+    let (scene, params) = packed(&lamps_in_clusters(d.path()), LightSampler::Tree);
+    let n = params.tree_emitters as usize;
+    assert!(n > 1000, "{n} emitters");
+    assert!(
+        scene.light_tree_clusters * 4 >= n / veach::packed::CLUSTER_EMITTERS,
+        "{} clusters",
+        scene.light_tree_clusters
+    );
+    let mut rng = Lcg(17);
+    // Below the round lamp, beside it (inside its clusters' bounding spheres), under the flat
+    // lamp and above it (behind its plane).
+    let contexts = [
+        LightContext { point: Vec3::new(0.3, -0.2, 0.0), normal: Vec3::Z, reflect_only: true },
+        LightContext { point: Vec3::new(0.45, 0.0, 1.2), normal: Vec3::X, reflect_only: false },
+        LightContext { point: Vec3::new(1.5, 0.5, 0.2), normal: Vec3::Z, reflect_only: true },
+        LightContext { point: Vec3::new(1.5, 0.5, 1.3), normal: Vec3::Z, reflect_only: false },
+    ];
+    for ctx in contexts {
+        let expected_pmf: Vec<f64> = (0..n as u32).map(|e| light_tree_pmf(&scene, &params, &ctx, e) as f64).collect();
+        let total: f64 = expected_pmf.iter().sum();
+        // (Below 1 where walks end where every bound is zero: above the flat lamp, its
+        // clusters in one plane are provably dark.)
+        assert!(total <= 1.0 + 1e-4 && total > 0.05, "from {}: Σ pmf {total}", ctx.point);
+        // Above the flat lamp (behind its plane) none of its triangles is chosen.
+        if ctx.point.z > 1.25 {
+            for e in 0..n as u32 {
+                let tri = &scene.triangles[veach::cpu::lights::light_entry(&scene, e).triangle as usize];
+                if tri.p0[0] > 1.0 {
+                    assert_eq!(expected_pmf[e as usize], 0.0, "flat lamp's emitter {e} from behind");
+                }
+            }
+        }
+        let draws = 200_000;
+        let mut observed = vec![0.0; n];
+        let mut chosen = 0;
+        for _ in 0..draws {
+            let (e, pmf) = sample_light_tree(&scene, &params, &ctx, rng.f());
+            if pmf > 0.0 {
+                observed[e as usize] += 1.0;
+                chosen += 1;
+                if chosen % 97 == 0 {
+                    assert_eq!(pmf.to_bits(), light_tree_pmf(&scene, &params, &ctx, e).to_bits(), "emitter {e}");
+                }
+            }
+        }
+        // The last bin: no emitter chosen.
+        observed.push((draws - chosen) as f64);
+        let expected: Vec<f64> =
+            expected_pmf.iter().chain([&(1.0 - total).max(0.0)]).map(|p| p * draws as f64).collect();
+        let what = format!("clustered light tree selection from {}", ctx.point);
+        common::chi2::pearson(&what, &observed, &expected, 1.0).assert_passes(&what, 0.01, contexts.len());
+    }
+}
+
 /// Mean squared error of `film` against `reference`, values clamped to [0, 1] as a
 /// tone-mapped image shows them.
 fn clamped_mse(film: &veach::Film, reference: &veach::Film) -> f64 {

@@ -6,7 +6,8 @@
 //! they emit into: an orientation cone (axis, θ_o) that holds every emitter's axis, plus the
 //! spread θ_e beyond it (a one-sided triangle emits into the hemisphere around its normal:
 //! θ_o = 0, θ_e = π/2). The build is top-down with the surface-area-and-orientation heuristic
-//! (SAOH) over 12 buckets per axis; one emitter per leaf, nodes in depth-first order (child 0
+//! (SAOH) over 12 buckets per axis; one emitter per leaf (the packer makes small subtrees
+//! that face one way clusters: `packed/light_tree.rs`), nodes in depth-first order (child 0
 //! follows its parent). Each emitter keeps the trail of child choices from the root (bit k:
 //! the child taken at depth k), which gives the exact probability of choosing it for MIS.
 //!

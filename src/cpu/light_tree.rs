@@ -1,7 +1,10 @@
 //! Twin of `shaders/light_tree.wgsl`: walking the light BVH (`accel/light_bvh.rs`) from the
 //! root with one random number, and the exact probability of choosing an emitter.
 
-use crate::packed::{LIGHT_LEAF, LIGHT_NODE_ROWS, LIGHT_TWO_SIDED, LightGroup, PackedScene};
+use crate::packed::{
+    CLUSTER_LAST, LIGHT_CLUSTER, LIGHT_INDEX_MASK, LIGHT_LEAF, LIGHT_NODE_ROWS, LIGHT_PLANAR, LIGHT_TWO_SIDED,
+    LightGroup, PackedScene,
+};
 use crate::params::Params;
 use glam::{BVec4A, Vec2, Vec3, Vec4};
 
@@ -26,10 +29,13 @@ pub struct LightNode {
     pub cos_o: f32,
     pub sin_o: f32,
     pub cos_e: f32,
-    /// Child 1 (interior) or the emitter (leaf).
+    /// Child 1 (interior), the emitter (leaf) or a cluster's first entry.
     pub index: u32,
     pub leaf: bool,
     pub two_sided: bool,
+    /// A leaf of several emitters (`index`: its first entry), in one plane when `planar`.
+    pub cluster: bool,
+    pub planar: bool,
 }
 
 use super::common::ONE_MINUS_EPSILON;
@@ -47,9 +53,11 @@ pub fn load_light_node(scene: &PackedScene, params: &Params, node: u32) -> Light
         cos_o: f(r2[0]),
         sin_o: f(r2[3]),
         cos_e: f(r2[1]),
-        index: r2[2] & !(LIGHT_LEAF | LIGHT_TWO_SIDED),
+        index: r2[2] & LIGHT_INDEX_MASK,
         leaf: r2[2] & LIGHT_LEAF != 0,
         two_sided: r2[2] & LIGHT_TWO_SIDED != 0,
+        cluster: r2[2] & LIGHT_CLUSTER != 0,
+        planar: r2[2] & LIGHT_PLANAR != 0,
     }
 }
 
@@ -116,19 +124,82 @@ pub fn node_importance(ctx: &LightContext, node: &LightNode) -> Vec2 {
     (node.phi * cos_p * cos_pi / d2).max(Vec2::ZERO)
 }
 
-/// A child's importances in the walk: a leaf holding a one-sided triangle is also tested
-/// against the triangle's own plane, so that a point behind it (even inside its bounding
-/// sphere, where the cone test cannot tell) gets probability 0.
+/// A child's importances in the walk: a leaf holding a one-sided triangle (or a cluster of
+/// them in one plane) is also tested against the triangle's own plane, so that a point
+/// behind it (even inside its bounding sphere, where the cone test cannot tell) gets
+/// probability 0.
 pub fn child_importance(scene: &PackedScene, params: &Params, ctx: &LightContext, node: &LightNode) -> Vec2 {
     let importance = node_importance(ctx, node);
-    if importance.x > 0.0 && node.leaf && !node.two_sided && node.index < params.light_count {
+    let emitter = if node.cluster { cluster_entry(scene, params, node.index).0 } else { node.index };
+    if importance.x > 0.0
+        && node.leaf
+        && !node.two_sided
+        && (!node.cluster || node.planar)
+        && emitter < params.light_count
+    {
         // The emitter triangle's plane (p0, e1 × e2), as packed for the group walk.
-        let [p0, n] = scene.light_planes[node.index as usize];
+        let [p0, n] = scene.light_planes[emitter as usize];
         if n.dot(ctx.point - p0) <= 0.0 {
             return Vec2::ZERO;
         }
     }
     importance
+}
+
+/// Entry `k` of the clusters' list: (emitter, its probability in the cluster, whether it is
+/// the cluster's last), two entries a row from the trails' first row.
+#[inline(always)]
+pub fn cluster_entry(scene: &PackedScene, params: &Params, k: u32) -> (u32, f32, bool) {
+    let row = scene.light_rows[(params.trail_base + k / 2) as usize];
+    let word = row[2 * (k % 2) as usize];
+    (word & !CLUSTER_LAST, f32::from_bits(row[2 * (k % 2) as usize + 1]), word & CLUSTER_LAST != 0)
+}
+
+/// The emitter `u` chooses in the cluster whose entries start at `first` (by power: each
+/// entry's stored probability; the last takes the rest up to 1), and that probability.
+pub fn choose_in_cluster(scene: &PackedScene, params: &Params, first: u32, u: f32) -> (u32, f32) {
+    let mut below = 0.0f32;
+    let mut k = first;
+    loop {
+        let (emitter, p, last) = cluster_entry(scene, params, k);
+        if last || u < below + p {
+            return (emitter, p);
+        }
+        below += p;
+        k += 1;
+    }
+}
+
+/// The probability that `choose_in_cluster` chooses `emitter` in the cluster from `first`.
+pub fn cluster_pmf(scene: &PackedScene, params: &Params, first: u32, emitter: u32) -> f32 {
+    let mut k = first;
+    loop {
+        let (e, p, last) = cluster_entry(scene, params, k);
+        if e == emitter {
+            return p;
+        }
+        if last {
+            return 0.0;
+        }
+        k += 1;
+    }
+}
+
+/// A leaf's emitter and the probability of choosing it there: its own, or one of its
+/// cluster's chosen with `u`.
+#[inline(always)]
+pub fn leaf_emitter(scene: &PackedScene, params: &Params, next: u32, u: f32) -> (u32, f32) {
+    if next & LIGHT_CLUSTER != 0 {
+        choose_in_cluster(scene, params, next & LIGHT_INDEX_MASK, u)
+    } else {
+        (next & LIGHT_INDEX_MASK, 1.0)
+    }
+}
+
+/// The probability of choosing `emitter` at the leaf `next` (1 for a leaf of one emitter).
+#[inline(always)]
+pub fn leaf_pmf(scene: &PackedScene, params: &Params, next: u32, emitter: u32) -> f32 {
+    if next & LIGHT_CLUSTER != 0 { cluster_pmf(scene, params, next & LIGHT_INDEX_MASK, emitter) } else { 1.0 }
 }
 
 /// The probability of taking the child with importances `i` when its sibling's sum with it
@@ -273,7 +344,10 @@ pub fn choose_child(shares: [f32; 4], u: f32) -> (usize, f32) {
 pub fn sample_light_tree(scene: &PackedScene, params: &Params, ctx: &LightContext, u: f32) -> (u32, f32) {
     let root = load_light_node(scene, params, 0);
     if root.leaf {
-        return (root.index, if child_importance(scene, params, ctx, &root).x > 0.0 { 1.0 } else { 0.0 });
+        if child_importance(scene, params, ctx, &root).x > 0.0 {
+            return leaf_emitter(scene, params, root_word(&root), u);
+        }
+        return (root.index, 0.0);
     }
     let mut group = &scene.light_groups[0];
     let mut u = u;
@@ -285,10 +359,16 @@ pub fn sample_light_tree(scene: &PackedScene, params: &Params, ctx: &LightContex
         pmf *= shares[slot];
         let next = group.next[slot];
         if next & LIGHT_LEAF != 0 {
-            return (next & !(LIGHT_LEAF | LIGHT_TWO_SIDED), pmf);
+            let (emitter, p) = leaf_emitter(scene, params, next, u);
+            return (emitter, pmf * p);
         }
         group = &scene.light_groups[(next & !LIGHT_TWO_SIDED) as usize];
     }
+}
+
+/// The root's index word as a group's `next` holds a leaf's.
+pub fn root_word(root: &LightNode) -> u32 {
+    root.index | if root.cluster { LIGHT_CLUSTER } else { 0 }
 }
 
 /// The probability that `sample_light_tree` chooses `emitter` from `ctx`: the walk down its
@@ -296,7 +376,8 @@ pub fn sample_light_tree(scene: &PackedScene, params: &Params, ctx: &LightContex
 pub fn light_tree_pmf(scene: &PackedScene, params: &Params, ctx: &LightContext, emitter: u32) -> f32 {
     let root = load_light_node(scene, params, 0);
     if root.leaf {
-        return if child_importance(scene, params, ctx, &root).x > 0.0 { 1.0 } else { 0.0 };
+        let lit = child_importance(scene, params, ctx, &root).x > 0.0;
+        return if lit { leaf_pmf(scene, params, root_word(&root), emitter) } else { 0.0 };
     }
     let row = scene.light_rows[(params.trail_base + emitter / 4) as usize];
     let mut trail = row[(emitter % 4) as usize];
@@ -309,7 +390,7 @@ pub fn light_tree_pmf(scene: &PackedScene, params: &Params, ctx: &LightContext, 
         let next = group.next[slot];
         trail >>= 2;
         if next & LIGHT_LEAF != 0 {
-            return pmf;
+            return pmf * leaf_pmf(scene, params, next, emitter);
         }
         group = &scene.light_groups[(next & !LIGHT_TWO_SIDED) as usize];
     }

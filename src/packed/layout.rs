@@ -44,6 +44,16 @@ pub const LIGHT_TREE_WIDTH: u32 = 4;
 pub const LIGHT_LEAF: u32 = 1 << 31;
 /// A light-tree node's index word: some emitter below emits from both faces.
 pub const LIGHT_TWO_SIDED: u32 = 1 << 30;
+/// A leaf's index word: the leaf is a cluster of emitters (the rest is the first of its
+/// entries, counted in pairs of words from the trails' first row), chosen inside by power.
+pub const LIGHT_CLUSTER: u32 = 1 << 29;
+/// A cluster's index word: its emitters are one-sided triangles in one plane (the first
+/// entry's), so a point behind that plane gets none of them.
+pub const LIGHT_PLANAR: u32 = 1 << 28;
+/// A cluster entry's emitter word: the cluster's last entry.
+pub const CLUSTER_LAST: u32 = 1 << 31;
+/// Index bits of a light-tree node's index word.
+pub const LIGHT_INDEX_MASK: u32 = LIGHT_PLANAR - 1;
 
 /// Per-triangle vertex attributes: octahedron-encoded normals and tangents
 /// (`pack2x16snorm`) and TEXCOORD_0, one of each per vertex.

@@ -1,13 +1,18 @@
 //! The light BVH as the kernel reads it: three rows per node, then the emitters' trails,
-//! four per row, after the alias table in the `lights` buffer (see `PackedScene::light_rows`).
+//! four per row, then the clusters' entries, two per row, after the alias table in the
+//! `lights` buffer (see `PackedScene::light_rows`).
 //!
 //! Node rows: (lo.xyz, phi), (hi.xyz, octahedral axis), (cos θ_o, cos θ_e, first child or
-//! emitter | LIGHT_LEAF | LIGHT_TWO_SIDED, sin θ_o). Floats are stored as f32 bits,
+//! emitter | LIGHT_LEAF | LIGHT_TWO_SIDED, or a cluster's first entry | LIGHT_LEAF |
+//! LIGHT_CLUSTER [| LIGHT_PLANAR], sin θ_o). A cluster entry is (emitter [| CLUSTER_LAST],
+//! its probability in the cluster as f32 bits). Floats are stored as f32 bits,
 //! unquantized, so the boxes are exact; only the axis is quantized, and θ_o is widened by
 //! its error so the cone still holds every emitter's normal. sin θ_o is stored so both
 //! twins read the same value instead of each computing it per visit.
 
-use super::layout::{LIGHT_LEAF, LIGHT_TWO_SIDED, PUNCTUAL_SPOT, Punctual};
+use super::layout::{
+    CLUSTER_LAST, LIGHT_CLUSTER, LIGHT_INDEX_MASK, LIGHT_LEAF, LIGHT_PLANAR, LIGHT_TWO_SIDED, PUNCTUAL_SPOT, Punctual,
+};
 use super::octahedral::{oct_decode, oct_encode};
 use crate::accel::light_bvh::{LightBounds, LightBvh, build_light_bvh, widen};
 use glam::Vec3;
@@ -55,25 +60,68 @@ fn finite_power(phi: f32) -> f32 {
 /// children: the walk takes half the steps and weighs up to four subtrees against each other.
 const LIGHT_TREE_WIDTH: usize = super::layout::LIGHT_TREE_WIDTH as usize;
 
+/// Subtrees of at most this many emitters whose normals lie within `CLUSTER_COS_O` become
+/// one leaf, a cluster chosen inside by power alone: the walk stops levels earlier (the
+/// lamps of a typical scene are meshes of many small triangles that face one way, where the
+/// importance of each triangle would hardly differ).
+pub const CLUSTER_EMITTERS: usize = 16;
+/// The widest orientation cone (cos θ_o) of a cluster.
+const CLUSTER_COS_O: f32 = 0.8;
+
 /// The packed tree.
 pub struct PackedLightTree {
-    /// Node rows then trail rows.
+    /// Node rows, trail rows, then cluster entry rows.
     pub rows: Vec<[u32; 4]>,
     /// Node records (three rows each): the root, then groups of `LIGHT_TREE_WIDTH` siblings.
     pub nodes: usize,
     pub trail_offset: u32,
     /// Deepest leaf of the packed tree (the root is depth 0).
     pub depth: u32,
+    /// Leaves that are clusters of several emitters.
+    pub clusters: usize,
     pub build_seconds: f64,
+}
+
+/// Whether one-sided triangles `corners` (emitter ids `members`) lie in one plane facing one
+/// way, within float tolerance.
+fn coplanar(members: &[u32], corners: &[[Vec3; 3]]) -> bool {
+    let Some(&[p0, p1, p2]) = members.first().and_then(|&m| corners.get(m as usize)) else { return false };
+    let n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+    if n == Vec3::ZERO {
+        return false;
+    }
+    let scale = members
+        .iter()
+        .filter_map(|&m| corners.get(m as usize))
+        .flatten()
+        .fold(0.0f32, |a, v| a.max((*v - p0).abs().max_element()));
+    members.iter().all(|&m| {
+        corners.get(m as usize).is_some_and(|&[a, b, c]| {
+            let nm = (b - a).cross(c - a).normalize_or_zero();
+            nm.dot(n) > 1.0 - 1e-6 && [a, b, c].iter().all(|v| n.dot(*v - p0).abs() <= 1e-6 * scale.max(1e-6))
+        })
+    })
 }
 
 /// Packs the binary light BVH as a 4-wide tree. Record 0 is the root; an interior record's
 /// index names the first of its group of four children (records `LIGHT_TREE_WIDTH` apart,
 /// children first, unused slots zero: no power, never chosen). An emitter's trail holds the
-/// slot taken at each level, two bits a level (depth ≤ 16: the binary tree's ≤ 32 halved).
-pub fn pack_light_tree(emitters: &[LightBounds]) -> PackedLightTree {
+/// slot taken at each level, two bits a level (depth ≤ 16: the binary tree's ≤ 32 halved);
+/// the emitters of a cluster share its trail. `corners` are the vertices of the emissive
+/// triangles (the first emitters), to find clusters that lie in one plane.
+pub fn pack_light_tree(emitters: &[LightBounds], corners: &[[Vec3; 3]]) -> PackedLightTree {
     let t0 = std::time::Instant::now();
     let LightBvh { nodes, trails: _, depth: _, build_seconds: _ } = build_light_bvh(emitters);
+    // Emitters below each binary node (children follow their parent in the array).
+    let mut count = vec![0usize; nodes.len()];
+    for i in (0..nodes.len()).rev() {
+        count[i] = if nodes[i].leaf { 1 } else { count[i + 1] + count[nodes[i].index as usize] };
+    }
+    let is_cluster = |i: usize| {
+        let b = &nodes[i].bounds;
+        !nodes[i].leaf && count[i] <= CLUSTER_EMITTERS && !b.two_sided && b.cos_o >= CLUSTER_COS_O && b.phi > 0.0
+    };
+    let leafish = |i: usize| nodes[i].leaf || is_cluster(i);
     // Every binary node's three rows (its index field filled in below).
     let mut encoded: Vec<[[u32; 4]; 3]> = vec![[[0; 4]; 3]; nodes.len()];
     encoded.par_iter_mut().zip(nodes.par_iter()).for_each(|(out, n)| {
@@ -91,43 +139,91 @@ pub fn pack_light_tree(emitters: &[LightBounds]) -> PackedLightTree {
     });
     let mut records: Vec<[[u32; 4]; 3]> = Vec::with_capacity(nodes.len());
     let mut trails = vec![0u32; emitters.len()];
+    // Cluster entries (emitter | CLUSTER_LAST on the last, probability bits), in pairs.
+    let mut entries: Vec<[u32; 2]> = Vec::new();
+    let mut clusters = 0;
+    // A leaf's record and its emitters' trails; a cluster's entries.
+    let mut leaf = |records: &mut Vec<[[u32; 4]; 3]>, r: usize, k: usize, t: u32| {
+        if nodes[k].leaf {
+            trails[nodes[k].index as usize] = t;
+            return;
+        }
+        let mut members = Vec::with_capacity(count[k]);
+        let mut stack = vec![k];
+        while let Some(i) = stack.pop() {
+            if nodes[i].leaf {
+                members.push(nodes[i].index);
+            } else {
+                stack.push(nodes[i].index as usize);
+                stack.push(i + 1);
+            }
+        }
+        // By power: each entry's probability stored, so both walks read the same number.
+        let total: f64 = members.iter().map(|&m| emitters[m as usize].phi as f64).sum();
+        let start = entries.len() as u32;
+        let positive: Vec<u32> = members.iter().copied().filter(|&m| emitters[m as usize].phi > 0.0).collect();
+        for (j, &m) in positive.iter().enumerate() {
+            let p = (emitters[m as usize].phi as f64 / total) as f32;
+            let last = if j + 1 == positive.len() { CLUSTER_LAST } else { 0 };
+            entries.push([m | last, p.to_bits()]);
+        }
+        for &m in &members {
+            trails[m as usize] = t;
+        }
+        let planar = if coplanar(&members, corners) { LIGHT_PLANAR } else { 0 };
+        records[r][2][2] = LIGHT_LEAF | LIGHT_CLUSTER | planar | start;
+        clusters += 1;
+    };
     let mut depth = 0;
     if let Some(root) = encoded.first() {
         records.push(*root);
     }
     // (binary node, its record, trail so far, level of its children)
     let mut stack: Vec<(usize, usize, u32, u32)> = Vec::new();
-    if nodes.first().is_some_and(|n| !n.leaf) {
-        stack.push((0, 0, 0, 0));
+    if !nodes.is_empty() {
+        if leafish(0) {
+            leaf(&mut records, 0, 0, 0);
+        } else {
+            stack.push((0, 0, 0, 0));
+        }
     }
     while let Some((b, r, trail, level)) = stack.pop() {
         let mut kids = [0usize; LIGHT_TREE_WIDTH];
-        let mut count = 0;
+        let mut filled = 0;
         for c in [b + 1, nodes[b].index as usize] {
-            if nodes[c].leaf {
-                kids[count] = c;
-                count += 1;
+            if leafish(c) {
+                kids[filled] = c;
+                filled += 1;
             } else {
-                kids[count] = c + 1;
-                kids[count + 1] = nodes[c].index as usize;
-                count += 2;
+                kids[filled] = c + 1;
+                kids[filled + 1] = nodes[c].index as usize;
+                filled += 2;
             }
         }
         let group = records.len();
         records[r][2][2] |= group as u32;
         records.extend(std::iter::repeat_n([[0; 4]; 3], LIGHT_TREE_WIDTH));
         depth = depth.max(level + 1);
-        for (slot, &k) in kids[..count].iter().enumerate() {
+        for (slot, &k) in kids[..filled].iter().enumerate() {
             let t = trail | (slot as u32) << (2 * level);
             records[group + slot] = encoded[k];
-            if nodes[k].leaf {
-                trails[nodes[k].index as usize] = t;
+            if leafish(k) {
+                leaf(&mut records, group + slot, k, t);
             } else {
                 stack.push((k, group + slot, t, level + 1));
             }
         }
     }
-    let mut rows: Vec<[u32; 4]> = Vec::with_capacity(3 * records.len() + trails.len().div_ceil(4));
+    let trail_rows = trails.len().div_ceil(4);
+    // Cluster entries are counted in pairs from the trails' first row.
+    let entry_base = 2 * trail_rows as u32;
+    assert!(entry_base as usize + entries.len() <= LIGHT_INDEX_MASK as usize, "too many emitters for the light tree");
+    for rec in &mut records {
+        if rec[2][2] & (LIGHT_LEAF | LIGHT_CLUSTER) == LIGHT_LEAF | LIGHT_CLUSTER {
+            rec[2][2] += entry_base;
+        }
+    }
+    let mut rows: Vec<[u32; 4]> = Vec::with_capacity(3 * records.len() + trail_rows + entries.len().div_ceil(2));
     rows.extend(records.iter().flatten());
     let trail_offset = rows.len() as u32;
     for chunk in trails.chunks(4) {
@@ -135,8 +231,12 @@ pub fn pack_light_tree(emitters: &[LightBounds]) -> PackedLightTree {
         row[..chunk.len()].copy_from_slice(chunk);
         rows.push(row);
     }
+    for pair in entries.chunks(2) {
+        let second = pair.get(1).copied().unwrap_or([0, 0]);
+        rows.push([pair[0][0], pair[0][1], second[0], second[1]]);
+    }
     let build_seconds = t0.elapsed().as_secs_f64();
-    PackedLightTree { rows, nodes: records.len(), trail_offset, depth, build_seconds }
+    PackedLightTree { rows, nodes: records.len(), trail_offset, depth, clusters, build_seconds }
 }
 
 /// The children of an interior node of the light tree (a group of `LIGHT_TREE_WIDTH`
@@ -153,11 +253,13 @@ pub struct LightGroup {
     pub cos_o: [f32; 4],
     pub sin_o: [f32; 4],
     pub cos_e: [f32; 4],
-    /// Per slot: a leaf's emitter | LIGHT_LEAF | LIGHT_TWO_SIDED, or an interior child's
-    /// own group index | LIGHT_TWO_SIDED.
+    /// Per slot: a leaf's emitter | LIGHT_LEAF | LIGHT_TWO_SIDED (a cluster's first entry
+    /// | LIGHT_LEAF | LIGHT_CLUSTER, with LIGHT_PLANAR), or an interior child's own group
+    /// index | LIGHT_TWO_SIDED.
     pub next: [u32; 4],
     /// Per slot holding a one-sided emissive triangle (a leaf, not two-sided, an emitter
-    /// below the scene's light count): all bits set, and the triangle's plane (a vertex and
+    /// below the scene's light count) or a cluster of them in one plane: all bits set, and
+    /// the (first) triangle's plane (a vertex and
     /// e1 × e2, as `PackedScene::light_planes` has them), so that the walk tests the four
     /// slots' planes at once (`attach_planes`).
     pub one_sided: [u32; 4],
@@ -165,13 +267,23 @@ pub struct LightGroup {
     pub plane_n: [[f32; 4]; 3],
 }
 
-/// Fills the groups' per-slot triangle planes from `planes` (one per emissive triangle).
-pub fn attach_planes(groups: &mut [LightGroup], planes: &[[Vec3; 2]]) {
+/// Fills the groups' per-slot triangle planes from `planes` (one per emissive triangle): a
+/// leaf's own triangle, or the first entry's of a cluster in one plane (`LIGHT_PLANAR`).
+/// `rows` are the `lights` buffer's rows, cluster entries counted from row `trail_base`.
+pub fn attach_planes(groups: &mut [LightGroup], planes: &[[Vec3; 2]], rows: &[[u32; 4]], trail_base: u32) {
     for g in groups {
         for lane in 0..LIGHT_TREE_WIDTH {
             let next = g.next[lane];
-            let emitter = (next & !(LIGHT_LEAF | LIGHT_TWO_SIDED)) as usize;
-            if next & (LIGHT_LEAF | LIGHT_TWO_SIDED) == LIGHT_LEAF && emitter < planes.len() {
+            let index = next & LIGHT_INDEX_MASK;
+            let emitter = match next & (LIGHT_LEAF | LIGHT_TWO_SIDED | LIGHT_CLUSTER | LIGHT_PLANAR) {
+                LIGHT_LEAF => index as usize,
+                f if f == LIGHT_LEAF | LIGHT_CLUSTER | LIGHT_PLANAR => {
+                    let row = rows[(trail_base + index / 2) as usize];
+                    (row[2 * (index % 2) as usize] & !CLUSTER_LAST) as usize
+                }
+                _ => continue,
+            };
+            if emitter < planes.len() {
                 let [p0, n] = planes[emitter];
                 g.one_sided[lane] = u32::MAX;
                 for k in 0..3 {

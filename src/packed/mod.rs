@@ -18,7 +18,7 @@ mod triangle_lanes;
 pub use crate::accel::{BvhNode, CwNode, INSTANCE_MIRRORED, Instance};
 pub use features::Features;
 pub use layout::*;
-pub use light_tree::LightGroup;
+pub use light_tree::{CLUSTER_EMITTERS, LightGroup};
 pub use materials::{dielectric_f0, luminance, pack_material};
 pub use octahedral::{oct_decode, oct_encode};
 pub use textures::{
@@ -65,7 +65,7 @@ fn has_texture(m: &Material) -> bool {
 /// bench`'s scale test.
 pub fn pack_light_tree_for_bench(emitters: &[crate::accel::light_bvh::LightBounds]) -> (usize, u32, f64, usize) {
     let t0 = std::time::Instant::now();
-    let t = pack_light_tree(emitters);
+    let t = pack_light_tree(emitters, &[]);
     (t.nodes, t.depth, t0.elapsed().as_secs_f64(), t.rows.len() * 16)
 }
 use lights::{build_alias_table, pack_punctual};
@@ -94,7 +94,8 @@ pub struct PackedScene {
     /// The `lights` buffer: the alias table (one row per entry, `LightEntry` as u32 bits),
     /// then from `tree_base` the light tree's node records (`LIGHT_NODE_ROWS` rows each: the
     /// root, then groups of `LIGHT_TREE_WIDTH` siblings) and from
-    /// `trail_base` its emitters' trails, four per row. At least one row.
+    /// `trail_base` its emitters' trails, four per row, then its clusters' entries, two per
+    /// row (a cluster's index word counts entries from `trail_base`). At least one row.
     pub light_rows: Vec<[u32; 4]>,
     /// The light tree's node axes decoded (`oct_decode` of each node's axis word), for the
     /// CPU engine: decoding is a normalization per node visit.
@@ -113,6 +114,8 @@ pub struct PackedScene {
     pub directional_count: u32,
     pub light_tree_nodes: usize,
     pub light_tree_depth: u32,
+    /// Leaves of the light tree that are clusters of several emitters.
+    pub light_tree_clusters: usize,
     pub light_tree_seconds: f64,
     /// Original scene index of each packed triangle.
     pub order: Vec<u32>,
@@ -212,7 +215,8 @@ impl PackedScene {
             for (i, l) in lights.iter().enumerate() {
                 triangles[l.triangle as usize].flags |= (i as u32 + 1) << TRI_EMITTER_SHIFT;
             }
-            Some(pack_light_tree(&emitters))
+            let corners: Vec<[Vec3; 3]> = lights.iter().map(|l| ordered[l.triangle as usize].positions).collect();
+            Some(pack_light_tree(&emitters, &corners))
         } else {
             // More emitters than the triangle flags can name: only the power sampler.
             None
@@ -221,6 +225,7 @@ impl PackedScene {
         let tree_base = light_rows.len() as u32;
         let mut light_axes = Vec::new();
         let mut light_groups = Vec::new();
+        let light_tree_clusters = tree.as_ref().map_or(0, |t| t.clusters);
         let (tree_emitters, trail_base, light_tree_nodes, light_tree_depth, light_tree_seconds) = match tree {
             Some(t) => {
                 light_rows.extend_from_slice(&t.rows);
@@ -297,6 +302,7 @@ impl PackedScene {
             directional_count,
             light_tree_nodes,
             light_tree_depth,
+            light_tree_clusters,
             light_tree_seconds,
             order: bvh.order,
             bvh_build_seconds: build_seconds,
@@ -327,7 +333,12 @@ impl PackedScene {
                 [Vec3::from(t.p0), Vec3::from(t.e1).cross(Vec3::from(t.e2))]
             })
             .collect();
-        light_tree::attach_planes(&mut packed.light_groups, &packed.light_planes);
+        light_tree::attach_planes(
+            &mut packed.light_groups,
+            &packed.light_planes,
+            &packed.light_rows,
+            packed.trail_base,
+        );
         packed.set_environment(&scene.environment);
         packed
     }

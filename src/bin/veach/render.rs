@@ -76,7 +76,8 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
         "textures_shrunk": packed.warnings.len(),
     });
     let (bvh_nodes, bvh_depth, bvh_seconds) = (packed.bvh_nodes, packed.bvh_depth, packed.bvh_build_seconds);
-    let light_tree = (packed.light_tree_nodes, packed.light_tree_depth, packed.light_tree_seconds);
+    let light_tree =
+        (packed.light_tree_nodes, packed.light_tree_depth, packed.light_tree_seconds, packed.light_tree_clusters);
     let (mut renderer, backend_reason) = crate::open_renderer(packed, &loaded.camera, &job.settings, args.backend)?;
     if renderer.environment_source() == veach::EnvironmentSource::Studio && job.settings.env_strength > 0.0 {
         eprintln!(
@@ -227,6 +228,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome, Error> {
             "light_tree_nodes": light_tree.0,
             "light_tree_depth": light_tree.1,
             "light_tree_build_seconds": light_tree.2,
+            "light_tree_clusters": light_tree.3,
             "backend_reason": backend_reason,
             "seconds_total": t0.elapsed().as_secs_f64(),
             "samples_per_second": samples_per_second,

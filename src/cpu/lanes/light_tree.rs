@@ -12,8 +12,11 @@
 use super::lane::{F8, M8, V3};
 use super::{LANES, lanes_of};
 use crate::cpu::common::ONE_MINUS_EPSILON;
-use crate::cpu::light_tree::{LightContext, child_importance, choose_child, group_shares, load_light_node};
-use crate::packed::{LIGHT_LEAF, LIGHT_TWO_SIDED, LightGroup, PackedScene};
+use crate::cpu::light_tree::{
+    LightContext, child_importance, choose_child, choose_in_cluster, group_shares, leaf_emitter, load_light_node,
+    root_word,
+};
+use crate::packed::{LIGHT_CLUSTER, LIGHT_INDEX_MASK, LIGHT_LEAF, LIGHT_TWO_SIDED, LightGroup, PackedScene};
 use crate::params::Params;
 
 /// Children of a light-tree group (`packed::LIGHT_TREE_WIDTH`).
@@ -262,7 +265,8 @@ impl<const N: usize> Walks<N> {
         self.pmf[e] *= share;
         let next = g.next[slot];
         if next & LIGHT_LEAF != 0 {
-            self.out[e] = (next & !(LIGHT_LEAF | LIGHT_TWO_SIDED), self.pmf[e]);
+            // A cluster's emitter is chosen after the walks (`u[e]` keeps the number for it).
+            self.out[e] = (next & (LIGHT_INDEX_MASK | LIGHT_CLUSTER), self.pmf[e]);
             self.walking &= !(1 << e);
         } else {
             self.group[e] = next & !LIGHT_TWO_SIDED;
@@ -342,7 +346,11 @@ pub fn sample_light_tree_candidates<const N: usize>(
     if root.leaf {
         for e in lanes_of(mask) {
             let i = e % LANES;
-            out[e] = (root.index, if child_importance(scene, params, &ctx[i], &root).x > 0.0 { 1.0 } else { 0.0 });
+            out[e] = if child_importance(scene, params, &ctx[i], &root).x > 0.0 {
+                leaf_emitter(scene, params, root_word(&root), u[e])
+            } else {
+                (root.index, 0.0)
+            };
         }
         return out;
     }
@@ -399,6 +407,15 @@ pub fn sample_light_tree_candidates<const N: usize>(
         }
         for e in lanes_of(b_walks) {
             w.step(g2, e, sb);
+        }
+    }
+    if scene.light_tree_clusters > 0 {
+        for e in lanes_of(mask) {
+            let (word, pmf) = w.out[e];
+            if word & LIGHT_CLUSTER != 0 {
+                let (emitter, p) = choose_in_cluster(scene, params, word & LIGHT_INDEX_MASK, w.u[e]);
+                w.out[e] = (emitter, pmf * p);
+            }
         }
     }
     w.out
