@@ -60,13 +60,21 @@ fn finite_power(phi: f32) -> f32 {
 /// children: the walk takes half the steps and weighs up to four subtrees against each other.
 const LIGHT_TREE_WIDTH: usize = super::layout::LIGHT_TREE_WIDTH as usize;
 
-/// Subtrees of at most this many emitters whose normals lie within `CLUSTER_COS_O` become
+/// Subtrees of at most this many emitters whose normals lie within `CLUSTER_COS_O` and whose
+/// triangles fill their box (`CLUSTER_FILL`) become
 /// one leaf, a cluster chosen inside by power alone: the walk stops levels earlier (the
 /// lamps of a typical scene are meshes of many small triangles that face one way, where the
 /// importance of each triangle would hardly differ).
 pub const CLUSTER_EMITTERS: usize = 16;
-/// The widest orientation cone (cos θ_o) of a cluster.
-const CLUSTER_COS_O: f32 = 0.8;
+/// The widest orientation cone (cos θ_o) of a cluster (26°): a cluster is chosen by power
+/// alone, so a point that sees some of its triangles from behind wastes the samples that
+/// choose those (two faces of a small octahedron, 35° apart, lost the glossy hall 30 % in
+/// error at 37°; BENCHMARKS.md session 25).
+const CLUSTER_COS_O: f32 = 0.9;
+/// A cluster's triangles cover at least this share of its box's squared diagonal (one lamp's
+/// patch of surface, not several lamps apart: across a gap the distance to each matters, and
+/// a glossy lobe that sees one of them would lose it to the others' power).
+const CLUSTER_FILL: f64 = 0.2;
 
 /// The packed tree.
 pub struct PackedLightTree {
@@ -117,9 +125,26 @@ pub fn pack_light_tree(emitters: &[LightBounds], corners: &[[Vec3; 3]]) -> Packe
     for i in (0..nodes.len()).rev() {
         count[i] = if nodes[i].leaf { 1 } else { count[i + 1] + count[nodes[i].index as usize] };
     }
+    // Emissive area below each node (−∞ below a punctual light: never a cluster).
+    let mut area = vec![0.0f64; nodes.len()];
+    for i in (0..nodes.len()).rev() {
+        area[i] = if nodes[i].leaf {
+            corners.get(nodes[i].index as usize).map_or(f64::NEG_INFINITY, |&[p0, p1, p2]| {
+                0.5 * (p1 - p0).as_dvec3().cross((p2 - p0).as_dvec3()).length()
+            })
+        } else {
+            area[i + 1] + area[nodes[i].index as usize]
+        };
+    }
     let is_cluster = |i: usize| {
         let b = &nodes[i].bounds;
-        !nodes[i].leaf && count[i] <= CLUSTER_EMITTERS && !b.two_sided && b.cos_o >= CLUSTER_COS_O && b.phi > 0.0
+        let diag2 = (b.hi - b.lo).as_dvec3().length_squared();
+        !nodes[i].leaf
+            && count[i] <= CLUSTER_EMITTERS
+            && !b.two_sided
+            && b.cos_o >= CLUSTER_COS_O
+            && b.phi > 0.0
+            && area[i] >= CLUSTER_FILL * diag2
     };
     let leafish = |i: usize| nodes[i].leaf || is_cluster(i);
     // Every binary node's three rows (its index field filled in below).
