@@ -109,12 +109,15 @@ fn node_importance(ctx: LightContext, node: LightNode) -> vec2<f32> {
 // (even inside its bounding sphere, where the cone test cannot tell) gets probability 0.
 fn child_importance(ctx: LightContext, node: LightNode) -> vec2<f32> {
     let importance = node_importance(ctx, node);
+    if (!(importance.x > 0.0 && node.leaf && !node.two_sided && (!node.cluster || node.planar))) {
+        return importance;
+    }
+    // A cluster's plane is its first entry's (read only where the test applies).
     var emitter = node.index;
     if (node.cluster) {
         emitter = cluster_entry(node.index).emitter;
     }
-    if (importance.x > 0.0 && node.leaf && !node.two_sided && (!node.cluster || node.planar)
-        && emitter < params.light_count) {
+    if (emitter < params.light_count) {
         let tri = load_triangle(lights[emitter].x);
         if (dot(cross(tri.e1, tri.e2), ctx.point - tri.p0) <= 0.0) {
             return vec2<f32>(0.0);

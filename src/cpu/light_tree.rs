@@ -130,13 +130,12 @@ pub fn node_importance(ctx: &LightContext, node: &LightNode) -> Vec2 {
 /// probability 0.
 pub fn child_importance(scene: &PackedScene, params: &Params, ctx: &LightContext, node: &LightNode) -> Vec2 {
     let importance = node_importance(ctx, node);
+    if !(importance.x > 0.0 && node.leaf && !node.two_sided && (!node.cluster || node.planar)) {
+        return importance;
+    }
+    // A cluster's plane is its first entry's (read only where the test applies).
     let emitter = if node.cluster { cluster_entry(scene, params, node.index).0 } else { node.index };
-    if importance.x > 0.0
-        && node.leaf
-        && !node.two_sided
-        && (!node.cluster || node.planar)
-        && emitter < params.light_count
-    {
+    if emitter < params.light_count {
         // The emitter triangle's plane (p0, e1 × e2), as packed for the group walk.
         let [p0, n] = scene.light_planes[emitter as usize];
         if n.dot(ctx.point - p0) <= 0.0 {
