@@ -13,11 +13,12 @@ use super::lane::{F8, M8, V3};
 use super::{LANES, lanes_of};
 use crate::cpu::common::ONE_MINUS_EPSILON;
 use crate::cpu::light_tree::{
-    LightContext, child_importance, choose_child, choose_in_cluster, group_shares, leaf_emitter, load_light_node,
-    root_word,
+    LightContext, LightNode, choose_child, choose_in_cluster, cluster_entry, group_shares, leaf_emitter,
+    load_light_node, root_word,
 };
 use crate::packed::{LIGHT_CLUSTER, LIGHT_INDEX_MASK, LIGHT_LEAF, LIGHT_TWO_SIDED, LightGroup, PackedScene};
 use crate::params::Params;
+use glam::Vec3;
 
 /// Children of a light-tree group (`packed::LIGHT_TREE_WIDTH`).
 const WIDTH: usize = crate::packed::LIGHT_TREE_WIDTH as usize;
@@ -143,6 +144,36 @@ fn child_importance_lanes(p: [F8; 3], n: [F8; 3], reflect_only: M8, c: &ChildLan
         e = F8::select(behind, zero, e);
     }
     (f, e)
+}
+
+/// The paths (lanes) for which a root leaf has positive importance: `child_importance`'s
+/// test of the root, the same operations for every path at once instead of path by path (a
+/// scene whose lights are one leaf, such as the Cornell box, tests it at every vertex).
+#[inline(always)]
+fn root_lit_lanes(scene: &PackedScene, params: &Params, c: &Contexts, root: &LightNode) -> M8 {
+    let s = F8::splat;
+    let v = |x: Vec3| [s(x.x), s(x.y), s(x.z)];
+    // The plane test of a one-sided triangle, or of a cluster's first entry in one plane.
+    let tested = root.leaf && !root.two_sided && (!root.cluster || root.planar);
+    let emitter = if root.cluster { cluster_entry(scene, params, root.index).0 } else { root.index };
+    let plane = (tested && emitter < params.light_count).then(|| scene.light_planes[emitter as usize]);
+    let [p0, n] = plane.unwrap_or([Vec3::ZERO; 2]);
+    let child = ChildLanes {
+        phi: s(root.phi),
+        lo: v(root.lo),
+        hi: v(root.hi),
+        axis: v(root.axis),
+        sin_o: s(root.sin_o),
+        cos_o: s(root.cos_o),
+        cos_e: s(root.cos_e),
+        two_sided: M8::splat(root.two_sided),
+        one_sided: M8::splat(plane.is_some()),
+        plane_p0: v(p0),
+        plane_n: v(n),
+    };
+    let p = [c.point.x, c.point.y, c.point.z];
+    let n = [c.normal.x, c.normal.y, c.normal.z];
+    child_importance_lanes(p, n, c.reflect_only, &child).0.gt(F8::splat(0.0))
 }
 
 /// `group_shares` of group `g` for every path in lanes: the four children's shares (lane i:
@@ -343,10 +374,15 @@ pub fn sample_light_tree_candidates<const N: usize>(
         return out;
     }
     let root = load_light_node(scene, params, 0);
+    let contexts = Contexts {
+        point: V3::from_fn(|i| ctx[i].point),
+        normal: V3::from_fn(|i| ctx[i].normal),
+        reflect_only: M8::from_fn(|i| ctx[i].reflect_only),
+    };
     if root.leaf {
+        let lit = root_lit_lanes(scene, params, &contexts, &root);
         for e in lanes_of(mask) {
-            let i = e % LANES;
-            out[e] = if child_importance(scene, params, &ctx[i], &root).x > 0.0 {
+            out[e] = if lit.lane(e % LANES) {
                 leaf_emitter(scene, params, root_word(&root), u[e])
             } else {
                 (root.index, 0.0)
@@ -354,11 +390,6 @@ pub fn sample_light_tree_candidates<const N: usize>(
         }
         return out;
     }
-    let contexts = Contexts {
-        point: V3::from_fn(|i| ctx[i].point),
-        normal: V3::from_fn(|i| ctx[i].normal),
-        reflect_only: M8::from_fn(|i| ctx[i].reflect_only),
-    };
     let mut w = Walks { group: [0; N], u: *u, pmf: [1.0; N], walking: mask, out };
     while w.walking != 0 {
         // The walks standing where the first walking one stands, and their paths.
