@@ -14,8 +14,9 @@ fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
 
 // Whether the triangle's solid angle from `p` is surely below SOLID_ANGLE_MIN, without the
 // exact formula: the triangle lies in the ball of radius r about its centroid c, whose cap
-// subtends at most 2π r²/d² (d = |p − c|); widened by 1 % so rounding never skips a triangle
-// the exact formula keeps.
+// subtends at most 2π r²/d² (d = |p − c|), and each of its points is at least d − r from p,
+// so Ω ≤ A·h/(d − r)³ (A·h = |(e1 × e2)·(p − p0)|/2); widened by 1 % and 10 % so rounding
+// never skips a triangle the exact formula keeps.
 fn surely_below_solid_angle_min(p: vec3<f32>, p0: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>) -> bool {
     let c = p0 + (e1 + e2) * (1.0 / 3.0);
     let a = p0 - c;
@@ -23,7 +24,12 @@ fn surely_below_solid_angle_min(p: vec3<f32>, p0: vec3<f32>, e1: vec3<f32>, e2: 
     let d = p0 + e2 - c;
     let r2 = max(max(dot(a, a), dot(b, b)), dot(d, d));
     let pc = p - c;
-    return 6.35 * r2 < SOLID_ANGLE_MIN * dot(pc, pc);
+    let d2 = dot(pc, pc);
+    if (6.35 * r2 < SOLID_ANGLE_MIN * d2) {
+        return true;
+    }
+    let gap = sqrt(d2) - sqrt(r2);
+    return gap > 0.0 && 0.55 * abs(dot(cross(e1, e2), p - p0)) < SOLID_ANGLE_MIN * (gap * gap * gap);
 }
 
 // The solid angle of the triangle seen from `p` (van Oosterom & Strackee).

@@ -261,18 +261,31 @@ fn shortcut_cases(n: usize) -> Vec<[Vec3; 4]> {
 #[test]
 fn the_solid_angle_shortcut_is_conservative() {
     use veach::cpu::spherical_triangle::{SOLID_ANGLE_MIN, spherical_triangle_area, surely_below_solid_angle_min};
-    let (mut skipped, mut kept_small) = (0, 0);
+    let (mut skipped, mut by_plane, mut kept_small) = (0, 0, 0);
     for [p, p0, e1, e2] in shortcut_cases(200_000) {
         let omega = spherical_triangle_area(p, p0, p0 + e1, p0 + e2);
         if surely_below_solid_angle_min(p, p0, e1, e2) {
             assert!(omega < SOLID_ANGLE_MIN, "skipped a triangle of Ω = {omega} ≥ {SOLID_ANGLE_MIN}");
             skipped += 1;
+            by_plane += u32::from(!sphere_bound_skips(p, p0, e1, e2));
         } else if omega < SOLID_ANGLE_MIN {
             kept_small += 1;
         }
     }
     assert!(skipped > 50_000, "the shortcut skipped only {skipped} of 200000");
-    println!("skipped {skipped}, left to the exact formula below the threshold {kept_small}");
+    // The second bound (A·h/(d − r)³) is not vacuous: it skips triangles the ball's cap keeps.
+    assert!(by_plane > 5_000, "the plane bound skipped only {by_plane} the ball's did not");
+    println!(
+        "skipped {skipped} ({by_plane} by the plane bound), left to the exact formula below the threshold {kept_small}"
+    );
+}
+
+/// The ball's bound of `surely_below_solid_angle_min` alone.
+fn sphere_bound_skips(p: Vec3, p0: Vec3, e1: Vec3, e2: Vec3) -> bool {
+    use veach::cpu::spherical_triangle::SOLID_ANGLE_MIN;
+    let c = p0 + (e1 + e2) / 3.0;
+    let r2 = (p0 - c).length_squared().max((p0 + e1 - c).length_squared()).max((p0 + e2 - c).length_squared());
+    6.35 * r2 < SOLID_ANGLE_MIN * (p - c).length_squared()
 }
 
 /// The WGSL twin of the shortcut decides as the Rust one does, and is as conservative: run on
@@ -300,11 +313,17 @@ fn the_wgsl_solid_angle_shortcut_decides_as_the_rust_one() {
         assert!(!gpu_skip || exact < SOLID_ANGLE_MIN, "the GPU skipped a triangle of Ω = {exact} (GPU Ω {})", o[1]);
         assert!((o[1] - exact).abs() <= 1e-4 * exact.max(1e-3), "solid angle {} on the GPU, {exact} on the CPU", o[1]);
         if gpu_skip != surely_below_solid_angle_min(p, p0, e1, e2) {
-            // Only a tie may decide differently: the two sides equal to float rounding.
+            // Only a tie may decide differently: the two sides of one bound equal to float
+            // rounding (the plane bound's within the square roots' rounding).
             let c = p0 + (e1 + e2) / 3.0;
             let r2 = (p0 - c).length_squared().max((p0 + e1 - c).length_squared()).max((p0 + e2 - c).length_squared());
             let (lhs, rhs) = (6.35 * r2, SOLID_ANGLE_MIN * (p - c).length_squared());
-            assert!((lhs - rhs).abs() <= 1e-5 * rhs, "GPU and CPU decide differently: {lhs} vs {rhs}");
+            let gap = (p - c).length() - r2.sqrt();
+            let (plhs, prhs) = (0.55 * e1.cross(e2).dot(p - p0).abs(), SOLID_ANGLE_MIN * gap * gap * gap);
+            assert!(
+                (lhs - rhs).abs() <= 1e-5 * rhs || (plhs - prhs).abs() <= 1e-4 * prhs.abs(),
+                "GPU and CPU decide differently: {lhs} vs {rhs}, {plhs} vs {prhs}"
+            );
             ties += 1;
         }
         skipped += gpu_skip as u32;

@@ -19,14 +19,23 @@ pub const SOLID_ANGLE_MIN: f32 = 0.1;
 pub const SOLID_ANGLE_MAX: f32 = 6.22;
 
 /// Whether the triangle's solid angle from `p` is surely below `SOLID_ANGLE_MIN`, without
-/// the exact formula's three normalisations and arc tangent: the triangle lies in the ball of
-/// radius r about its centroid c, whose cap subtends 2π(1 − √(1 − r²/d²)) ≤ 2π r²/d² (d =
-/// |p − c|; when p is inside the ball the bound exceeds 2π and never skips). Widened by 1 %
+/// the exact formula's three normalisations and arc tangent. Two bounds: the triangle lies in
+/// the ball of radius r about its centroid c, whose cap subtends 2π(1 − √(1 − r²/d²)) ≤
+/// 2π r²/d² (d = |p − c|; when p is inside the ball the bound exceeds 2π and never skips);
+/// and every point x of the triangle is at least d − r from p, so Ω = ∫ h/|x − p|³ dA ≤
+/// A·h/(d − r)³, h the distance to its plane (A·h = |(e1 × e2)·(p − p0)|/2: no square root
+/// but d's and r's) — the one that skips the points near a lamp but off to its side, where
+/// the ball's cap is large (the walls and ceiling of the Cornell box). Widened by 1 % and 10 %
 /// so rounding never skips a triangle the exact formula would keep: the choice is the same.
 pub fn surely_below_solid_angle_min(p: Vec3, p0: Vec3, e1: Vec3, e2: Vec3) -> bool {
     let c = p0 + (e1 + e2) * (1.0 / 3.0);
     let r2 = (p0 - c).length_squared().max((p0 + e1 - c).length_squared()).max((p0 + e2 - c).length_squared());
-    6.35 * r2 < SOLID_ANGLE_MIN * (p - c).length_squared()
+    let d2 = (p - c).length_squared();
+    if 6.35 * r2 < SOLID_ANGLE_MIN * d2 {
+        return true;
+    }
+    let gap = d2.sqrt() - r2.sqrt();
+    gap > 0.0 && 0.55 * e1.cross(e2).dot(p - p0).abs() < SOLID_ANGLE_MIN * (gap * gap * gap)
 }
 
 /// The solid angle of the triangle (v0, v1, v2) seen from `p` (van Oosterom & Strackee).

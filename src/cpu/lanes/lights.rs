@@ -118,8 +118,12 @@ fn triangle_solid_angle(p: V3, p0: V3, e1: V3, e2: V3, mask: u32) -> F8 {
     let c = p0 + (e1 + e2) * F8::splat(1.0 / 3.0);
     let l2 = |v: V3| v.dot(v);
     let r2 = l2(p0 - c).max_num(l2(p0 + e1 - c)).max_num(l2(p0 + e2 - c));
-    let surely_below = (6.35 * r2).lt(SOLID_ANGLE_MIN * l2(p - c));
-    let behind = e1.cross(e2).dot(p - p0).le(zero);
+    let d2 = l2(p - c);
+    let gap = d2.sqrt() - r2.sqrt();
+    let side = e1.cross(e2).dot(p - p0);
+    let surely_below = (6.35 * r2).lt(SOLID_ANGLE_MIN * d2)
+        | (gap.gt(zero) & (0.55 * side.abs()).lt(SOLID_ANGLE_MIN * (gap * gap * gap)));
+    let behind = side.le(zero);
     let skip = behind | surely_below | !M8::from_bits(mask);
     if skip.bits() == M8::splat(true).bits() {
         // Every lane takes the scalar's early return (the common case far from a lamp).
