@@ -184,7 +184,10 @@ def test_errors_are_pythons_with_the_clis_messages(tmp_path):
 
 CHILD = textwrap.dedent(
     """
-    import sys, veach
+    import signal, sys, veach
+    # Python ignores Ctrl-C in a process started with SIGINT ignored (a shell's background
+    # job): take it back, as an interactive session has it.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     def progress(done, total, seconds):
         if done >= 2:
             print("rendering", flush=True)
@@ -217,11 +220,16 @@ def test_ctrl_c_stops_within_a_second_and_keeps_the_partial_image():
 def test_interrupted_is_a_keyboard_interrupt_in_process():
     import _thread
 
+    # interrupt_main does nothing where SIGINT is ignored (pytest run as a background job).
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(0.5, _thread.interrupt_main)
     timer.start()
-    with pytest.raises(KeyboardInterrupt) as caught:
-        small(width=64, height=64, spp=1000000)
-    timer.cancel()
+    try:
+        with pytest.raises(KeyboardInterrupt) as caught:
+            small(width=64, height=64, spp=1000000)
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, previous)
     assert isinstance(caught.value, veach.Interrupted)
     assert 1 <= caught.value.image.spp < 1000000
 
