@@ -104,12 +104,18 @@ fn node_importance(ctx: LightContext, node: LightNode) -> vec2<f32> {
     return max(node.phi * cos_p * cos_pi / d2, vec2<f32>(0.0));
 }
 
+// Is a point behind the node's plane given probability 0? A leaf of one one-sided triangle, or
+// a cluster of them in one plane (tested with its first entry's).
+fn plane_tested(node: LightNode) -> bool {
+    return node.leaf && !node.two_sided && (!node.cluster || node.planar);
+}
+
 // A child's importances in the walk: a leaf holding a one-sided triangle (or a cluster of
 // them in one plane) is also tested against the triangle's own plane, so a point behind it
 // (even inside its bounding sphere, where the cone test cannot tell) gets probability 0.
 fn child_importance(ctx: LightContext, node: LightNode) -> vec2<f32> {
     let importance = node_importance(ctx, node);
-    if (!(importance.x > 0.0 && node.leaf && !node.two_sided && (!node.cluster || node.planar))) {
+    if (!(importance.x > 0.0 && plane_tested(node))) {
         return importance;
     }
     // A cluster's plane is its first entry's (read only where the test applies).

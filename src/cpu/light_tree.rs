@@ -130,7 +130,7 @@ pub fn node_importance(ctx: &LightContext, node: &LightNode) -> Vec2 {
 /// probability 0.
 pub fn child_importance(scene: &PackedScene, params: &Params, ctx: &LightContext, node: &LightNode) -> Vec2 {
     let importance = node_importance(ctx, node);
-    if !(importance.x > 0.0 && node.leaf && !node.two_sided && (!node.cluster || node.planar)) {
+    if !(importance.x > 0.0 && plane_tested(node)) {
         return importance;
     }
     // A cluster's plane is its first entry's (read only where the test applies).
@@ -143,6 +143,13 @@ pub fn child_importance(scene: &PackedScene, params: &Params, ctx: &LightContext
         }
     }
     importance
+}
+
+/// Is a point behind the node's plane given probability 0? A leaf of one one-sided triangle, or
+/// a cluster of them in one plane (tested with its first entry's).
+#[inline(always)]
+pub fn plane_tested(node: &LightNode) -> bool {
+    node.leaf && !node.two_sided && (!node.cluster || node.planar)
 }
 
 /// Entry `k` of the clusters' list: (emitter, its probability in the cluster, whether it is
@@ -271,12 +278,10 @@ fn group_importance(ctx: &LightContext, g: &LightGroup) -> (Vec4, Vec4) {
     let cos_i = dot3(wi, n).abs();
     let sin_i = safe_sqrt(Vec4::ONE - cos_i * cos_i);
     let cos_pi = cos_sub(sin_i, cos_i, sin_b, cos_b);
-    let lit = phi * cos_p * cos_pi;
-    let (mut far, mut near) = (max_ps(lit / d2_far, zero), max_ps(lit / d2_near, zero));
-    far = Vec4::select(culled, zero, far);
-    near = Vec4::select(culled, zero, near);
-    far = Vec4::select(inside, phi / d2_far, far);
-    near = Vec4::select(inside, phi / d2_near, near);
+    // One division per estimate: inside the sphere phi / d², culled 0 / d² = 0, else the
+    // lit power over d² — the scalar's values exactly (phi > 0 where not dead).
+    let lit = Vec4::select(inside, phi, Vec4::select(culled, zero, phi * cos_p * cos_pi));
+    let (far, near) = (max_ps(lit / d2_far, zero), max_ps(lit / d2_near, zero));
     (Vec4::select(dead, zero, far), Vec4::select(dead, zero, near))
 }
 

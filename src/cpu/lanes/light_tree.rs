@@ -14,7 +14,7 @@ use super::{LANES, lanes_of};
 use crate::cpu::common::ONE_MINUS_EPSILON;
 use crate::cpu::light_tree::{
     LightContext, LightNode, choose_child, choose_in_cluster, cluster_entry, group_shares, leaf_emitter,
-    load_light_node, root_word,
+    load_light_node, plane_tested, root_word,
 };
 use crate::packed::{LIGHT_CLUSTER, LIGHT_INDEX_MASK, LIGHT_LEAF, LIGHT_TWO_SIDED, LightGroup, PackedScene};
 use crate::params::Params;
@@ -129,12 +129,9 @@ fn child_importance_lanes(p: [F8; 3], n: [F8; 3], reflect_only: M8, c: &ChildLan
     let cos_i = dot3(wi, n).abs();
     let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
     let cos_pi = cos_sub(sin_i, cos_i, sin_b, cos_b);
-    let lit = c.phi * cos_p * cos_pi;
+    // One division per estimate (`group_importance`'s: the same values).
+    let lit = F8::select(inside, c.phi, F8::select(culled, zero, c.phi * cos_p * cos_pi));
     let (mut f, mut e) = (max_ps(lit / d2_far, zero), max_ps(lit / d2_near, zero));
-    f = F8::select(culled, zero, f);
-    e = F8::select(culled, zero, e);
-    f = F8::select(inside, c.phi / d2_far, f);
-    e = F8::select(inside, c.phi / d2_near, e);
     f = F8::select(dead, zero, f);
     e = F8::select(dead, zero, e);
     if c.one_sided.bits() != 0 {
@@ -153,8 +150,7 @@ fn child_importance_lanes(p: [F8; 3], n: [F8; 3], reflect_only: M8, c: &ChildLan
 fn root_lit_lanes(scene: &PackedScene, params: &Params, c: &Contexts, root: &LightNode) -> M8 {
     let s = F8::splat;
     let v = |x: Vec3| [s(x.x), s(x.y), s(x.z)];
-    // The plane test of a one-sided triangle, or of a cluster's first entry in one plane.
-    let tested = root.leaf && !root.two_sided && (!root.cluster || root.planar);
+    let tested = plane_tested(root);
     let emitter = if root.cluster { cluster_entry(scene, params, root.index).0 } else { root.index };
     let plane = (tested && emitter < params.light_count).then(|| scene.light_planes[emitter as usize]);
     let [p0, n] = plane.unwrap_or([Vec3::ZERO; 2]);
