@@ -14,7 +14,7 @@
 #   --seed N            seed for both renderers (default 7)
 #   --repeat N          timed runs per renderer and scene; the median is reported (default 1)
 #   --mitsuba-rr-depth N  Mitsuba's rr_depth (default 5 = Mitsuba's default; veach starts
-#                       Russian roulette after 3 segments, so 3 makes the integrators match)
+#                       Russian roulette after 4 segments, so 4 makes the integrators match)
 #   --variants LIST     Mitsuba variants (default llvm_ad_rgb,scalar_rgb; "" = no Mitsuba)
 #   --backends LIST     veach backends (default gpu,cpu; "" = no veach)
 #   --veach-sampler S   veach's --sampler (default sobol, veach's default; Mitsuba runs its

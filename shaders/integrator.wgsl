@@ -67,6 +67,9 @@ struct PathState {
     ray: Ray,
     radiance: vec3<f32>,
     beta: vec3<f32>,
+    // The product of η² over the refractions so far: beta · eta_scale is the throughput without
+    // the 1/η² that leaving a denser medium undoes, for Russian roulette.
+    eta_scale: f32,
     // Path segments so far (Mitsuba's depth): 1 after the camera ray's hit.
     depth: u32,
     // The previous vertex's BSDF sample: its density (divided by candidate_pdf_scale where
@@ -102,7 +105,7 @@ struct SurfaceVertex {
 
 // A path starting along `camera_ray`.
 fn path_new(camera_ray: Ray) -> PathState {
-    return PathState(camera_ray, vec3<f32>(0.0), vec3<f32>(1.0), 0u, 0.0, true,
+    return PathState(camera_ray, vec3<f32>(0.0), vec3<f32>(1.0), 1.0, 0u, 0.0, true,
         LightContext(vec3<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0), false), AOVS, vec3<f32>(1.0), aov_none(),
         ALL_CHANNELS);
 }
@@ -365,6 +368,12 @@ fn path_connect_light(path: ptr<function, PathState>, sv: SurfaceVertex, ls: Lig
     }
 }
 
+// Did the BSDF sample `wi` (local) cross a dielectric interface, its weight scaled by 1/η²?
+// (A thin wall's transmission and diffuse transmission are not.)
+fn refracted(m: Material, wi: vec3<f32>) -> bool {
+    return TRANSMISSION && wi.z < 0.0 && m.transmission > 0.0 && (m.flags & MAT_THIN_WALLED) == 0u;
+}
+
 // The BSDF sample that continues the path (and finds emitters for the MIS estimator), then
 // Russian roulette. False when the path ends.
 fn path_scatter(path: ptr<function, PathState>, sampler: ptr<function, Sampler>, sv: SurfaceVertex) -> bool {
@@ -385,6 +394,9 @@ fn path_scatter(path: ptr<function, PathState>, sampler: ptr<function, Sampler>,
     if (max_component((*path).beta) <= 0.0) {
         return false;
     }
+    if (refracted(sv.mat, bs.wi)) {
+        (*path).eta_scale *= sv.eta * sv.eta;
+    }
     // Against several light candidates MIS sees the BSDF's density scaled down.
     let count = light_candidates(sv.mat);
     (*path).prev_pdf = select(bs.pdf, bs.pdf / candidate_pdf_scale(params.strategy, count), count > 1u);
@@ -393,7 +405,7 @@ fn path_scatter(path: ptr<function, PathState>, sampler: ptr<function, Sampler>,
     (*path).ray = Ray(spawn_point(sv.point, sv.ng, wi), wi);
 
     if ((*path).depth >= params.rr_depth) {
-        let q = min(max_component((*path).beta), 0.95);
+        let q = min(max_component((*path).beta * (*path).eta_scale), 0.95);
         if (sample_1d(sampler) >= q) {
             return false;
         }

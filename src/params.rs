@@ -92,8 +92,10 @@ pub const PROJECTION_ORTHOGRAPHIC: u32 = 1;
 /// Light candidates per glossy vertex with `LightSampler::Ris` (measured in BENCHMARKS.md).
 pub const RIS_CANDIDATES: u32 = 4;
 
-/// Russian roulette starts once a path has this many segments.
-pub const RR_DEPTH: u32 = 3;
+/// Russian roulette starts once a path has this many segments: 4 measured best at equal time
+/// on the Cornell box and the glass box among 3–6 while keeping the README's render within its
+/// time (BENCHMARKS.md session 27; Mitsuba's default is 5).
+pub const RR_DEPTH: u32 = 4;
 
 /// The environment is a light when it is not black: all of light sampling when the scene has
 /// no emissive triangles, else half of it.

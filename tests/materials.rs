@@ -894,6 +894,56 @@ fn glass_in_a_furnace_neither_creates_nor_loses_energy() {
     glass_furnace_on(None);
 }
 
+/// Russian roulette weighs a path by its throughput without refraction's 1/η² (pbrt-v4's and
+/// Mitsuba's rule): through white smooth glass every BSDF sample's weight is 1 but for that
+/// factor, so `beta · eta_scale` stays 1 and every roulette keeps the path with probability
+/// 0.95 and divides by it. Without the rule a roulette inside the glass (beta 1/η²) would keep
+/// the path with probability 1/η², and it would leave the glass weighing η². The scalar
+/// stages (the lanes and the WGSL kernel follow the same rule: tests/films.rs, tests/lanes.rs).
+#[test]
+fn roulette_sees_the_throughput_without_the_eta_squared_of_refraction() {
+    use veach::cpu::bvh::{NO_HIT, intersect_closest};
+    use veach::cpu::camera::camera_sample;
+    use veach::cpu::integrator::{PathState, path_scatter, path_surface};
+    let path = glass_furnace(0.0, 1.5, "stages");
+    let (scene, camera) = common::load_pair(&path, None).unwrap();
+    let packed = veach::PackedScene::new(&scene);
+    let s = Settings { width: 32, height: 32, max_depth: 0, env_color: Some([1.0; 3]), ..Settings::default() };
+    let params = veach::params::Params::new(&camera, &s, s.window(), &packed);
+    let mut rouletted_inside = 0;
+    for pixel in 0..32 * 32 {
+        let (ray, sampler) = camera_sample(&params, glam::UVec2::new(pixel % 32, pixel / 32));
+        let mut p = PathState::new(&params, ray, sampler);
+        let mut rouletted = 0;
+        while p.depth < 64 {
+            let hit = intersect_closest(&packed, &p.ray);
+            p.depth += 1;
+            if hit.tri == NO_HIT {
+                break;
+            }
+            let Some(sv) = path_surface(&packed, &params, &mut p, &hit) else { break };
+            if !path_scatter(&params, &mut p, &sv) {
+                break;
+            }
+            if p.depth >= params.rr_depth {
+                rouletted += 1;
+                // In the glass after this vertex: its eta_scale is η².
+                rouletted_inside += usize::from(p.eta_scale > 2.0);
+            }
+            let unscaled = p.beta * p.eta_scale * 0.95f32.powi(rouletted);
+            assert!(
+                (unscaled - Vec3::ONE).abs().max_element() < 1e-4,
+                "pixel {pixel}, depth {}: beta {} eta_scale {} after {rouletted} roulettes",
+                p.depth,
+                p.beta,
+                p.eta_scale
+            );
+        }
+    }
+    // Not vacuous: roulette met paths inside the glass.
+    assert!(rouletted_inside > 50, "{rouletted_inside} roulettes inside the glass");
+}
+
 #[test]
 #[cfg_attr(veach_no_gpu, ignore = "needs a GPU adapter (no Vulkan driver on this machine)")]
 fn glass_in_a_furnace_neither_creates_nor_loses_energy_on_the_gpu() {

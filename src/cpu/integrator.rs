@@ -111,6 +111,10 @@ pub struct PathState {
     pub ray: Ray,
     pub radiance: Vec3,
     pub beta: Vec3,
+    /// The product of η² over the refractions so far: `beta · eta_scale` is the throughput
+    /// without the 1/η² that radiance gains entering a denser medium, which leaving undoes, so
+    /// Russian roulette does not end paths inside glass for it (pbrt-v4's and Mitsuba's rule).
+    pub eta_scale: f32,
     /// Path segments so far (Mitsuba's depth): 1 after the camera ray's hit.
     pub depth: u32,
     /// The previous vertex's BSDF sample: its density (divided by `candidate_pdf_scale` where
@@ -135,6 +139,7 @@ impl PathState {
             ray: camera_ray,
             radiance: Vec3::ZERO,
             beta: Vec3::ONE,
+            eta_scale: 1.0,
             depth: 0,
             prev_pdf: 0.0,
             prev_delta: true,
@@ -510,6 +515,13 @@ pub fn path_scatter_u(path: &mut PathState) -> Vec3 {
     Vec3::new(u0, u12.x, u12.y)
 }
 
+/// Did the BSDF sample `wi` (local) cross a dielectric interface, its weight scaled by 1/η²?
+/// (A thin wall's transmission and diffuse transmission are not.)
+#[inline(always)]
+pub fn refracted(m: &Material, wi: Vec3) -> bool {
+    wi.z < 0.0 && m.transmission > 0.0 && m.flags & MAT_THIN_WALLED == 0
+}
+
 /// The path continues along the BSDF sample `bs`, then Russian roulette. False when it ends.
 #[inline(always)]
 pub fn path_continue(params: &Params, path: &mut PathState, sv: &SurfaceVertex, bs: &BsdfSample) -> bool {
@@ -527,6 +539,9 @@ pub fn path_continue(params: &Params, path: &mut PathState, sv: &SurfaceVertex, 
     if path.beta.max_element() <= 0.0 {
         return false;
     }
+    if refracted(&sv.mat, bs.wi) {
+        path.eta_scale *= sv.eta * sv.eta;
+    }
     // Against several light candidates MIS sees the BSDF's density scaled down.
     let count = light_candidates(params, &sv.mat);
     path.prev_pdf = if count > 1 { bs.pdf / candidate_pdf_scale(path_strategy(params), count) } else { bs.pdf };
@@ -535,7 +550,7 @@ pub fn path_continue(params: &Params, path: &mut PathState, sv: &SurfaceVertex, 
     path.ray = Ray { origin: spawn_point(sv.point, sv.ng, wi), dir: wi };
 
     if path.depth >= params.rr_depth {
-        let q = path.beta.max_element().min(0.95);
+        let q = (path.beta * path.eta_scale).max_element().min(0.95);
         if sample_1d(&mut path.sampler) >= q {
             return false;
         }

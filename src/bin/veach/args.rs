@@ -294,7 +294,7 @@ pub struct RenderArgs {
     pub height: u32,
     /// Longest path, counted in segments as Mitsuba's max_depth: 1 = emitters seen directly,
     /// 2 = direct lighting only, 8 = up to 7 bounces (pbrt's maxdepth is this minus 1);
-    /// 0 = no limit (Russian roulette, from 3 segments on, ends paths).
+    /// 0 = no limit (Russian roulette, from 4 segments on, ends paths).
     #[arg(long, conflicts_with = "resume", default_value_t = 8)]
     pub max_depth: u32,
     /// Seed of the random sequences; the same seed renders the same image.

@@ -36,6 +36,7 @@ pub struct Paths {
     pub dir: V3,
     pub radiance: V3,
     pub beta: V3,
+    pub eta_scale: F8,
     pub depth: U8,
     pub prev_pdf: F8,
     pub prev_delta: M8,
@@ -57,6 +58,7 @@ impl Paths {
             dir: V3::from_fn(|i| s[i].ray.dir),
             radiance: V3::from_fn(|i| s[i].radiance),
             beta: V3::from_fn(|i| s[i].beta),
+            eta_scale: F8::from_fn(|i| s[i].eta_scale),
             depth: U8::from_fn(|i| s[i].depth),
             prev_pdf: F8::from_fn(|i| s[i].prev_pdf),
             prev_delta: mask(&|p| p.prev_delta),
@@ -77,6 +79,7 @@ impl Paths {
             ray: Ray { origin: self.origin.lane(i), dir: self.dir.lane(i) },
             radiance: self.radiance.lane(i),
             beta: self.beta.lane(i),
+            eta_scale: self.eta_scale.0[i],
             depth: self.depth.0[i],
             prev_pdf: self.prev_pdf.0[i],
             prev_delta: self.prev_delta.lane(i),
@@ -99,6 +102,7 @@ impl Paths {
         self.dir.set_lane(i, p.ray.dir);
         self.radiance.set_lane(i, p.radiance);
         self.beta.set_lane(i, p.beta);
+        self.eta_scale.0[i] = p.eta_scale;
         self.depth.0[i] = p.depth;
         self.prev_pdf.0[i] = p.prev_pdf;
         self.prev_delta.set_lane(i, p.prev_delta);
@@ -650,7 +654,8 @@ fn bounce_plain(scene: &PackedScene, params: &Params, paths: &mut Paths, hits: &
     paths.dir = V3::select(go, wi, paths.dir);
     let roulette = go & paths.depth.ge(params.rr_depth);
     if roulette.bits() != 0 {
-        let q = paths.beta.max_element().min_num(F8::splat(0.95));
+        // (Plain surfaces do not refract: `eta_scale` is what the path brought here.)
+        let q = (paths.beta * paths.eta_scale).max_element().min_num(F8::splat(0.95));
         let x = paths.sampler.sample_1d(roulette);
         let ends = roulette & x.ge(q);
         go = go & !ends;
