@@ -368,12 +368,6 @@ fn path_connect_light(path: ptr<function, PathState>, sv: SurfaceVertex, ls: Lig
     }
 }
 
-// Did the BSDF sample `wi` (local) cross a dielectric interface, its weight scaled by 1/η²?
-// (A thin wall's transmission and diffuse transmission are not.)
-fn refracted(m: Material, wi: vec3<f32>) -> bool {
-    return TRANSMISSION && wi.z < 0.0 && m.transmission > 0.0 && (m.flags & MAT_THIN_WALLED) == 0u;
-}
-
 // The BSDF sample that continues the path (and finds emitters for the MIS estimator), then
 // Russian roulette. False when the path ends.
 fn path_scatter(path: ptr<function, PathState>, sampler: ptr<function, Sampler>, sv: SurfaceVertex) -> bool {

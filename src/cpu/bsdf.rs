@@ -279,6 +279,14 @@ pub fn base_eval(m: &Material, wo: Vec3, wi: Vec3, eta: f32) -> Vec3 {
 /// The rough transmission lobe's density of wi (wi.z < 0) times `p_lobe`, the probability
 /// of choosing the lobe (multiplied first, as the films recorded before the lobe had a function
 /// of its own were computed).
+/// Did the BSDF sample `wi` (local) cross a dielectric interface, its weight scaled by 1/η²
+/// (`specular_transmission_eval` and the smooth refraction in `base_sample`)? A thin wall's
+/// transmission and diffuse transmission are not. Russian roulette divides the factor out.
+#[inline(always)]
+pub fn refracted(m: &Material, wi: Vec3) -> bool {
+    wi.z < 0.0 && m.transmission > 0.0 && m.flags & MAT_THIN_WALLED == 0
+}
+
 pub fn specular_transmission_pdf(m: &Material, wo: Vec3, wi: Vec3, eta: f32, alpha: f32, p_lobe: f32) -> f32 {
     if m.flags & MAT_THIN_WALLED != 0 {
         let r = thin_reflection(wi);

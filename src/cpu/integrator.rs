@@ -2,7 +2,7 @@
 
 use super::bsdf::{
     BsdfSample, DELTA_ALPHA, LobeChoice, bsdf_albedo, bsdf_eval, bsdf_is_delta, bsdf_pdf_chosen, bsdf_sample_chosen,
-    lobe_choice,
+    lobe_choice, refracted,
 };
 use super::bvh::{Hit, NO_HIT, intersect_closest, occluded, offset_ray};
 use super::camera::camera_sample;
@@ -513,13 +513,6 @@ pub fn path_scatter_u(path: &mut PathState) -> Vec3 {
     let u0 = sample_1d(&mut path.sampler);
     let u12 = sample_2d(&mut path.sampler);
     Vec3::new(u0, u12.x, u12.y)
-}
-
-/// Did the BSDF sample `wi` (local) cross a dielectric interface, its weight scaled by 1/η²?
-/// (A thin wall's transmission and diffuse transmission are not.)
-#[inline(always)]
-pub fn refracted(m: &Material, wi: Vec3) -> bool {
-    wi.z < 0.0 && m.transmission > 0.0 && m.flags & MAT_THIN_WALLED == 0
 }
 
 /// The path continues along the BSDF sample `bs`, then Russian roulette. False when it ends.
