@@ -2,7 +2,8 @@
 //! renders the reference kernel's films bit for bit: every scene and setting that changes
 //! what a path does — light samplers, samplers, strategies, glass, textures with alpha,
 //! instancing, punctual lights, environments, AOVs, adaptive sampling, clamping, tiles, a lens
-//! — and images whose width is not a multiple of the packet, so that packets are partial.
+//! — and images whose width is not a multiple of the packet or below it, so that lanes take
+//! new paths (`lanes::render_row`) from pixels and samples in every arrangement.
 
 mod common;
 
@@ -53,6 +54,8 @@ fn packets_of_paths_render_the_reference_films_bit_for_bit() {
             4,
         ),
         ("furnace".into(), asset("furnace-a080.gltf"), base(24, 24, 8), 4),
+        // Rows narrower than a packet: a pixel's next sample waits for its last (a lane idles).
+        ("cornell three pixels wide".into(), asset("cornell-box.gltf"), base(3, 16, 8), 6),
         (
             "cornell adaptive".into(),
             asset("cornell-box.gltf"),

@@ -1,7 +1,7 @@
 //! The CPU engine: the integrator of this folder over the film's pixels with rayon, the twin
 //! of `gpu::GpuRenderer`.
 
-use super::lanes::{LANES, lanes_of, render_packet};
+use super::lanes;
 use crate::adaptive::{adaptive_add_sample, adaptive_settle, adaptive_test_due};
 use crate::aov::aov_add_sample;
 use crate::film::{ADAPTIVE_WORDS, AOV_WORDS, Film, WORDS_PER_PIXEL, film_add_sample};
@@ -82,39 +82,28 @@ fn render_row(kernel: Kernel, scene: &PackedScene, base: &Params, samples: std::
     }
 }
 
-/// `render_row` with packets of `LANES` neighbouring pixels: each pixel still gets its
-/// samples in order, so its sums are the same bits.
+/// `render_row` with the row's paths in packets of `LANES` lanes (`lanes::render_row`): each
+/// pixel still gets its samples in order, so its sums are the same bits.
 fn render_row_lanes(scene: &PackedScene, base: &Params, samples: std::ops::Range<u32>, y: usize, row: Row) {
-    let Row { words, mut adaptive, mut aovs } = row;
+    let Row { words, adaptive, mut aovs } = row;
     let width = words.len() / WORDS_PER_PIXEL;
-    for s in samples {
-        let p = Params { sample_index: s, ..*base };
-        for x0 in (0..width).step_by(LANES) {
-            let n = (width - x0).min(LANES);
-            let mut mask = 0u32;
-            for i in 0..n {
-                if adaptive.as_ref().is_none_or(|(_, flags)| flags[x0 + i] == 0) {
-                    mask |= 1 << i;
-                }
-            }
-            if mask == 0 {
-                continue;
-            }
-            let results = render_packet(scene, &p, x0 as u32, y as u32, mask);
-            for i in lanes_of(mask) {
-                let x = x0 + i;
-                let (l, aov) = &results[i];
-                let pixel = &mut words[x * WORDS_PER_PIXEL..(x + 1) * WORDS_PER_PIXEL];
-                film_add_sample(pixel, *l);
-                if let Some((records, _)) = &mut adaptive {
-                    adaptive_add_sample(&p, pixel, &mut records[x * ADAPTIVE_WORDS..(x + 1) * ADAPTIVE_WORDS], *l);
-                }
-                if let Some(records) = &mut aovs {
-                    aov_add_sample(&mut records[x * AOV_WORDS..(x + 1) * AOV_WORDS], aov);
-                }
-            }
+    let (mut records, flags) = match adaptive {
+        Some((records, flags)) => (Some(records), Some(flags)),
+        None => (None, None),
+    };
+    let converged = |x: u32| flags.is_some_and(|f| f[x as usize] != 0);
+    lanes::render_row(scene, base, samples, y as u32, width as u32, converged, |s, x, l, aov| {
+        let x = x as usize;
+        let pixel = &mut words[x * WORDS_PER_PIXEL..(x + 1) * WORDS_PER_PIXEL];
+        film_add_sample(pixel, l);
+        if let Some(records) = &mut records {
+            let p = Params { sample_index: s, ..*base };
+            adaptive_add_sample(&p, pixel, &mut records[x * ADAPTIVE_WORDS..(x + 1) * ADAPTIVE_WORDS], l);
         }
-    }
+        if let Some(records) = &mut aovs {
+            aov_add_sample(&mut records[x * AOV_WORDS..(x + 1) * AOV_WORDS], aov);
+        }
+    });
 }
 
 impl Renderer {

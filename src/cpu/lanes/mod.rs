@@ -1,12 +1,12 @@
 //! Paths in lanes: the CPU engine's default kernel (`cpu::Kernel::Lanes`). A packet of
-//! `LANES` paths (consecutive pixels of a film row, the same sample index) keeps its state in
-//! SIMD lanes (`paths.rs`, types in `lane.rs`) and goes through the integrator's stages
-//! together; on plain surfaces (`paths::plain_material`) the surface, next-event and BSDF
-//! stages are arithmetic over lanes (the BSDF in `bsdf.rs`), and what branches per path — the
-//! BVH walks, light selection (the tree's walks side by side, `light_tree.rs`), the light
-//! sample, the shadow test — runs lane by lane. Every path draws the same numbers and does the
-//! same operations in the same order as the scalar reference (`integrator.rs`), so the films
-//! are the same bits (tests/lanes.rs holds the two to that).
+//! `LANES` paths (pixels of one film row; a lane whose path ends takes the row's next pixel or
+//! sample, `render_row`) keeps its state in SIMD lanes (`paths.rs`, types in `lane.rs`) and
+//! goes through the integrator's stages together; on plain surfaces (`paths::plain_material`)
+//! the surface, next-event and BSDF stages are arithmetic over lanes (the BSDF in `bsdf.rs`),
+//! and what branches per path — the BVH walks, light selection (the tree's walks side by side,
+//! `light_tree.rs`), the light sample, the shadow test — runs lane by lane. Every path draws
+//! the same numbers and does the same operations in the same order as the scalar reference
+//! (`integrator.rs`), so the films are the same bits (tests/lanes.rs holds the two to that).
 
 pub mod bsdf;
 pub mod lane;
@@ -22,7 +22,7 @@ use crate::aov::AovSample;
 use crate::packed::PackedScene;
 use crate::params::Params;
 use glam::{UVec2, Vec3};
-use paths::{Paths, trace_paths};
+use paths::{PathQueue, Paths, trace_paths};
 
 /// Paths in a packet.
 pub const LANES: usize = 8;
@@ -41,24 +41,84 @@ pub fn lanes_of(mask: u32) -> impl Iterator<Item = usize> {
     })
 }
 
-/// What a packet's sample gave each of its pixels: radiance and the AOV sample.
-pub type PacketResult = [(Vec3, AovSample); LANES];
-
-/// Sample `params.sample_index` of the film pixels `x0 + i` of row `y` for the lanes `i` in
-/// `mask`: each lane's radiance and AOV sample, as `render_sample` gives them one by one.
-pub fn render_packet(scene: &PackedScene, params: &Params, x0: u32, y: u32, mask: u32) -> PacketResult {
+/// Samples `samples` of the pixels `0..width` of film row `y` for which `skip` is false,
+/// eight paths at a time in the lanes of one packet. Paths start in sample-major order, and a
+/// lane whose path ends takes the next at once, so lanes stay busy however long their paths
+/// are; a pixel's next sample waits while its last is in flight. `add(sample, x, radiance,
+/// aov)` receives each path's result as it ends, so each pixel's samples in order (the film's
+/// sums, hence its bits, do not depend on which lane ran which path).
+pub fn render_row(
+    scene: &PackedScene,
+    params: &Params,
+    samples: std::ops::Range<u32>,
+    y: u32,
+    width: u32,
+    skip: impl Fn(u32) -> bool,
+    add: impl FnMut(u32, u32, Vec3, &AovSample),
+) {
     let placeholder = PathState::new(
         params,
         super::common::Ray { origin: Vec3::ZERO, dir: Vec3::Z },
-        super::sampler::sampler_init(params.sampler, 0, params.sample_index, 0),
+        super::sampler::sampler_init(params.sampler, 0, samples.start, 0),
     );
-    let mut states = [placeholder; LANES];
-    for i in lanes_of(mask) {
-        let pixel = UVec2::new(x0 + i as u32 + params.tile_x, y + params.tile_y);
-        let (ray, sampler) = camera_sample(params, pixel);
-        states[i] = PathState::new(params, ray, sampler);
+    let mut paths = Paths::from_states(&[placeholder; LANES]);
+    let mut queue =
+        RowQueue { params, y, width, end: samples.end, next: (samples.start, 0), running: [None; LANES], skip, add };
+    queue.skip_converged();
+    trace_paths(scene, params, &mut paths, 0, &mut queue);
+}
+
+/// The (sample, pixel) pairs of a film row in sample-major order, handed to idle lanes.
+struct RowQueue<'a, S, A> {
+    params: &'a Params,
+    y: u32,
+    width: u32,
+    end: u32,
+    /// The next (sample, x) to start; sample == end when none is left.
+    next: (u32, u32),
+    /// The (sample, x) each lane runs.
+    running: [Option<(u32, u32)>; LANES],
+    skip: S,
+    add: A,
+}
+
+impl<S: Fn(u32) -> bool, A: FnMut(u32, u32, Vec3, &AovSample)> RowQueue<'_, S, A> {
+    /// Moves `next` past the pixels `skip` leaves out.
+    fn skip_converged(&mut self) {
+        let (mut s, mut x) = self.next;
+        while s < self.end && (x >= self.width || (self.skip)(x)) {
+            if x >= self.width {
+                (s, x) = (s + 1, 0);
+            } else {
+                x += 1;
+            }
+        }
+        self.next = (s, x);
     }
-    let mut paths = Paths::from_states(&states);
-    trace_paths(scene, params, &mut paths, mask);
-    lane::per_lane(|i| (paths.radiance.lane(i), paths.aov[i]))
+}
+
+impl<S: Fn(u32) -> bool, A: FnMut(u32, u32, Vec3, &AovSample)> PathQueue for RowQueue<'_, S, A> {
+    fn finished(&mut self, i: usize, paths: &Paths) {
+        if let Some((s, x)) = self.running[i].take() {
+            (self.add)(s, x, paths.radiance.lane(i), &paths.aov[i]);
+        }
+    }
+
+    fn next(&mut self, i: usize) -> Option<PathState> {
+        let (s, x) = self.next;
+        if s >= self.end || self.running.iter().any(|r| r.is_some_and(|(_, rx)| rx == x)) {
+            return None;
+        }
+        self.next = (s, x + 1);
+        self.skip_converged();
+        self.running[i] = Some((s, x));
+        let params = Params { sample_index: s, ..*self.params };
+        let pixel = UVec2::new(x + params.tile_x, self.y + params.tile_y);
+        let (ray, sampler) = camera_sample(&params, pixel);
+        Some(PathState::new(&params, ray, sampler))
+    }
+
+    fn pending(&self) -> bool {
+        self.next.0 < self.end
+    }
 }

@@ -117,22 +117,41 @@ impl Paths {
     }
 }
 
-/// Runs the paths of `alive` to their ends. On x86-64 CPUs with AVX2 (checked at run time) it
-/// runs compiled for AVX2, so the lanes' arithmetic is one instruction for the packet; the
-/// operations, hence the bits, are the same either way.
-pub fn trace_paths(scene: &PackedScene, params: &Params, paths: &mut Paths, alive: u32) {
+/// Where a packet's lanes find new paths and leave ended ones: a lane whose path ends takes
+/// the next path at once, so the packet's arithmetic keeps its lanes busy instead of running
+/// for the longest of eight paths while the others idle.
+pub trait PathQueue {
+    /// Lane `i`'s path has ended: its radiance and AOV sample in `paths` are final.
+    fn finished(&mut self, i: usize, paths: &Paths);
+    /// A path for the idle lane `i`, if one may start now.
+    fn next(&mut self, i: usize) -> Option<PathState>;
+    /// Are paths left to start?
+    fn pending(&self) -> bool;
+}
+
+/// Runs the paths of `alive` to their ends, and those `queue` gives the lanes as theirs end. On
+/// x86-64 CPUs with AVX2 (checked at run time) it runs compiled for AVX2, so the lanes'
+/// arithmetic is one instruction for the packet; the operations, hence the bits, are the same
+/// either way, and so is each path's whatever lane it runs in.
+pub fn trace_paths<Q: PathQueue>(scene: &PackedScene, params: &Params, paths: &mut Paths, alive: u32, queue: &mut Q) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (checked just above).
-        return unsafe { trace_paths_avx2(scene, params, paths, alive) };
+        return unsafe { trace_paths_avx2(scene, params, paths, alive, queue) };
     }
-    trace_paths_loop(scene, params, paths, alive)
+    trace_paths_loop(scene, params, paths, alive, queue)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn trace_paths_avx2(scene: &PackedScene, params: &Params, paths: &mut Paths, alive: u32) {
-    trace_paths_loop(scene, params, paths, alive)
+unsafe fn trace_paths_avx2<Q: PathQueue>(
+    scene: &PackedScene,
+    params: &Params,
+    paths: &mut Paths,
+    alive: u32,
+    queue: &mut Q,
+) {
+    trace_paths_loop(scene, params, paths, alive, queue)
 }
 
 /// Can `bounce_plain` take a hit on material `m` (its index `index`) in this scene?
@@ -148,9 +167,33 @@ fn plain_material(scene: &PackedScene, params: &Params, m: &Material, index: usi
 }
 
 #[inline(always)]
-fn trace_paths_loop(scene: &PackedScene, params: &Params, paths: &mut Paths, mut alive: u32) {
+fn trace_paths_loop<Q: PathQueue>(
+    scene: &PackedScene,
+    params: &Params,
+    paths: &mut Paths,
+    mut alive: u32,
+    queue: &mut Q,
+) {
     let mut hits = [Hit { t: INF, tri: NO_HIT, u: 0.0, v: 0.0, instance: 0 }; LANES];
-    while alive != 0 {
+    loop {
+        // Idle lanes take new paths (the first refusal holds for the rest), except when every
+        // path in flight is about to take its last segment: that bounce is emission alone and
+        // skips the surface stages, which new paths beside it would run for a few lanes (with
+        // depth 2, every second bounce; measured, BENCHMARKS.md session 28).
+        let finishing =
+            alive != 0 && params.max_depth != 0 && lanes_of(alive).all(|i| paths.depth.0[i] + 1 >= params.max_depth);
+        if queue.pending() && !finishing {
+            for i in lanes_of(!alive & ((1 << LANES) - 1)) {
+                let Some(p) = queue.next(i) else { break };
+                paths.set_lane(i, &p);
+                alive |= 1 << i;
+            }
+        }
+        if alive == 0 {
+            // (Nothing in flight, so nothing holds a path back: the queue is empty.)
+            break;
+        }
+        let before = alive;
         for i in lanes_of(alive) {
             hits[i] = intersect_closest(scene, &Ray { origin: paths.origin.lane(i), dir: paths.dir.lane(i) });
             paths.depth.0[i] += 1;
@@ -187,6 +230,9 @@ fn trace_paths_loop(scene: &PackedScene, params: &Params, paths: &mut Paths, mut
         if plain != 0 {
             let survivors = bounce_plain(scene, params, paths, &hits, plain);
             alive = (alive & !plain) | survivors;
+        }
+        for i in lanes_of(before & !alive) {
+            queue.finished(i, paths);
         }
     }
 }

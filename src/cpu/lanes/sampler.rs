@@ -42,12 +42,12 @@ pub fn sobol_1_reversed(index: U8) -> U8 {
     })
 }
 
-/// The samplers of a packet's paths. `kind` and `index` (the sample index) are the packet's;
-/// the rest is per lane.
+/// The samplers of a packet's paths. `kind` is the packet's; the rest, the sample index
+/// included (a lane whose path ends takes another pixel's or sample's), is per lane.
 #[derive(Clone, Copy, Debug)]
 pub struct SamplerLanes {
     pub kind: u32,
-    pub index: u32,
+    pub index: U8,
     pub pixel_seed: U8,
     pub dim: U8,
     /// The independent sampler's PCG state.
@@ -55,12 +55,12 @@ pub struct SamplerLanes {
 }
 
 impl SamplerLanes {
-    /// Lane i is `samplers[i]` (all of one kind and sample index).
+    /// Lane i is `samplers[i]` (all of one kind).
     pub fn from_samplers(samplers: &[Sampler; super::LANES]) -> SamplerLanes {
         let parts = samplers.map(|s| sampler_parts(&s));
         SamplerLanes {
             kind: parts[0].0,
-            index: parts[0].2,
+            index: U8::from_fn(|i| parts[i].2),
             pixel_seed: U8::from_fn(|i| parts[i].1),
             dim: U8::from_fn(|i| parts[i].3),
             state: U8::from_fn(|i| parts[i].4),
@@ -70,14 +70,15 @@ impl SamplerLanes {
     /// Lane i's sampler.
     #[inline(always)]
     pub fn lane(&self, i: usize) -> Sampler {
-        sampler_from_parts(self.kind, self.pixel_seed.0[i], self.index, self.dim.0[i], self.state.0[i])
+        sampler_from_parts(self.kind, self.pixel_seed.0[i], self.index.0[i], self.dim.0[i], self.state.0[i])
     }
 
     /// Lane i becomes `s`.
     #[inline(always)]
     pub fn set_lane(&mut self, i: usize, s: &Sampler) {
-        let (_, pixel_seed, _, dim, state) = sampler_parts(s);
+        let (_, pixel_seed, index, dim, state) = sampler_parts(s);
         self.pixel_seed.0[i] = pixel_seed;
+        self.index.0[i] = index;
         self.dim.0[i] = dim;
         self.state.0[i] = state;
     }
@@ -111,7 +112,7 @@ impl SamplerLanes {
             return self.rng_next(m);
         }
         let d = self.next_dimension_seed(m);
-        let i = owen_scramble(U8::splat(self.index), d);
+        let i = owen_scramble(self.index, d);
         reverse_bits(laine_karras(i, pcg_hash(d.map(|d| d ^ 1)))).unit_float()
     }
 
@@ -124,7 +125,7 @@ impl SamplerLanes {
             return (a, b);
         }
         let d = self.next_dimension_seed(m);
-        let i = owen_scramble(U8::splat(self.index), d);
+        let i = owen_scramble(self.index, d);
         let x = reverse_bits(laine_karras(i, pcg_hash(d.map(|d| d ^ 1))));
         let y = reverse_bits(laine_karras(sobol_1_reversed(i), pcg_hash(d.map(|d| d ^ 2))));
         (x.unit_float(), y.unit_float())
