@@ -428,7 +428,7 @@ def cmd_report(a):
     llvm = f", LLVM {mts['llvm_version']}" if mts.get("llvm_version") else ""
     print(f"Mitsuba {mts['mitsuba_version']} (drjit {mts['drjit_version']}{llvm}); "
           f"{s['width']}x{s['height']}, {s['spp']} spp, max depth {s['max_depth']}, "
-          f"Mitsuba rr_depth {s['rr_depth']} (veach: 3); median of {s['repeat']} timed run(s)")
+          f"Mitsuba rr_depth {s['rr_depth']} (veach: 4, src/params.rs RR_DEPTH); median of {s['repeat']} timed run(s)")
     have_rmse = any("rmse_vs_mitsuba_llvm" in r or "rmse_vs_reference" in r for r in runs)
     hdr = f"{'scene':8s} {'renderer':15s} {'Msamples/s':>10s} {'seconds':>8s}  {'mean R G B':>26s}"
     if have_rmse:
