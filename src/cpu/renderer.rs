@@ -92,13 +92,12 @@ fn render_row_lanes(scene: &PackedScene, base: &Params, samples: std::ops::Range
         None => (None, None),
     };
     let converged = |x: u32| flags.is_some_and(|f| f[x as usize] != 0);
-    lanes::render_row(scene, base, samples, y as u32, width as u32, converged, |s, x, l, aov| {
+    lanes::render_row(scene, base, samples, y as u32, width as u32, converged, |p, x, l, aov| {
         let x = x as usize;
         let pixel = &mut words[x * WORDS_PER_PIXEL..(x + 1) * WORDS_PER_PIXEL];
         film_add_sample(pixel, l);
         if let Some(records) = &mut records {
-            let p = Params { sample_index: s, ..*base };
-            adaptive_add_sample(&p, pixel, &mut records[x * ADAPTIVE_WORDS..(x + 1) * ADAPTIVE_WORDS], l);
+            adaptive_add_sample(p, pixel, &mut records[x * ADAPTIVE_WORDS..(x + 1) * ADAPTIVE_WORDS], l);
         }
         if let Some(records) = &mut aovs {
             aov_add_sample(&mut records[x * AOV_WORDS..(x + 1) * AOV_WORDS], aov);

@@ -44,9 +44,10 @@ pub fn lanes_of(mask: u32) -> impl Iterator<Item = usize> {
 /// Samples `samples` of the pixels `0..width` of film row `y` for which `skip` is false,
 /// eight paths at a time in the lanes of one packet. Paths start in sample-major order, and a
 /// lane whose path ends takes the next at once, so lanes stay busy however long their paths
-/// are; a pixel's next sample waits while its last is in flight. `add(sample, x, radiance,
-/// aov)` receives each path's result as it ends, so each pixel's samples in order (the film's
-/// sums, hence its bits, do not depend on which lane ran which path).
+/// are; a pixel's next sample waits while its last is in flight. `add(params, x, radiance,
+/// aov)` receives each path's result as it ends (`params` with the path's sample index), so
+/// each pixel's samples in order (the film's sums, hence its bits, do not depend on which lane
+/// ran which path).
 pub fn render_row(
     scene: &PackedScene,
     params: &Params,
@@ -54,18 +55,12 @@ pub fn render_row(
     y: u32,
     width: u32,
     skip: impl Fn(u32) -> bool,
-    add: impl FnMut(u32, u32, Vec3, &AovSample),
+    add: impl FnMut(&Params, u32, Vec3, &AovSample),
 ) {
-    let placeholder = PathState::new(
-        params,
-        super::common::Ray { origin: Vec3::ZERO, dir: Vec3::Z },
-        super::sampler::sampler_init(params.sampler, 0, samples.start, 0),
-    );
-    let mut paths = Paths::from_states(&[placeholder; LANES]);
     let mut queue =
         RowQueue { params, y, width, end: samples.end, next: (samples.start, 0), running: [None; LANES], skip, add };
     queue.skip_converged();
-    trace_paths(scene, params, &mut paths, 0, &mut queue);
+    trace_paths(scene, params, &mut queue);
 }
 
 /// The (sample, pixel) pairs of a film row in sample-major order, handed to idle lanes.
@@ -82,7 +77,12 @@ struct RowQueue<'a, S, A> {
     add: A,
 }
 
-impl<S: Fn(u32) -> bool, A: FnMut(u32, u32, Vec3, &AovSample)> RowQueue<'_, S, A> {
+impl<S: Fn(u32) -> bool, A: FnMut(&Params, u32, Vec3, &AovSample)> RowQueue<'_, S, A> {
+    /// The row's params for sample `s`.
+    fn sample_params(&self, s: u32) -> Params {
+        Params { sample_index: s, ..*self.params }
+    }
+
     /// Moves `next` past the pixels `skip` leaves out.
     fn skip_converged(&mut self) {
         let (mut s, mut x) = self.next;
@@ -97,10 +97,11 @@ impl<S: Fn(u32) -> bool, A: FnMut(u32, u32, Vec3, &AovSample)> RowQueue<'_, S, A
     }
 }
 
-impl<S: Fn(u32) -> bool, A: FnMut(u32, u32, Vec3, &AovSample)> PathQueue for RowQueue<'_, S, A> {
+impl<S: Fn(u32) -> bool, A: FnMut(&Params, u32, Vec3, &AovSample)> PathQueue for RowQueue<'_, S, A> {
     fn finished(&mut self, i: usize, paths: &Paths) {
         if let Some((s, x)) = self.running[i].take() {
-            (self.add)(s, x, paths.radiance.lane(i), &paths.aov[i]);
+            let params = self.sample_params(s);
+            (self.add)(&params, x, paths.radiance.lane(i), &paths.aov[i]);
         }
     }
 
@@ -112,7 +113,7 @@ impl<S: Fn(u32) -> bool, A: FnMut(u32, u32, Vec3, &AovSample)> PathQueue for Row
         self.next = (s, x + 1);
         self.skip_converged();
         self.running[i] = Some((s, x));
-        let params = Params { sample_index: s, ..*self.params };
+        let params = self.sample_params(s);
         let pixel = UVec2::new(x + params.tile_x, self.y + params.tile_y);
         let (ray, sampler) = camera_sample(&params, pixel);
         Some(PathState::new(&params, ray, sampler))

@@ -129,29 +129,24 @@ pub trait PathQueue {
     fn pending(&self) -> bool;
 }
 
-/// Runs the paths of `alive` to their ends, and those `queue` gives the lanes as theirs end. On
-/// x86-64 CPUs with AVX2 (checked at run time) it runs compiled for AVX2, so the lanes'
-/// arithmetic is one instruction for the packet; the operations, hence the bits, are the same
-/// either way, and so is each path's whatever lane it runs in.
-pub fn trace_paths<Q: PathQueue>(scene: &PackedScene, params: &Params, paths: &mut Paths, alive: u32, queue: &mut Q) {
+/// Runs the paths `queue` gives, eight at a time in the lanes of a packet, each lane taking
+/// the next path as its own ends. On x86-64 CPUs with AVX2 (checked at run time) it runs
+/// compiled for AVX2, so the lanes' arithmetic is one instruction for the packet; the
+/// operations, hence the bits, are the same either way, and so is each path's whatever lane it
+/// runs in.
+pub fn trace_paths<Q: PathQueue>(scene: &PackedScene, params: &Params, queue: &mut Q) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (checked just above).
-        return unsafe { trace_paths_avx2(scene, params, paths, alive, queue) };
+        return unsafe { trace_paths_avx2(scene, params, queue) };
     }
-    trace_paths_loop(scene, params, paths, alive, queue)
+    trace_paths_loop(scene, params, queue)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn trace_paths_avx2<Q: PathQueue>(
-    scene: &PackedScene,
-    params: &Params,
-    paths: &mut Paths,
-    alive: u32,
-    queue: &mut Q,
-) {
-    trace_paths_loop(scene, params, paths, alive, queue)
+unsafe fn trace_paths_avx2<Q: PathQueue>(scene: &PackedScene, params: &Params, queue: &mut Q) {
+    trace_paths_loop(scene, params, queue)
 }
 
 /// Can `bounce_plain` take a hit on material `m` (its index `index`) in this scene?
@@ -167,13 +162,11 @@ fn plain_material(scene: &PackedScene, params: &Params, m: &Material, index: usi
 }
 
 #[inline(always)]
-fn trace_paths_loop<Q: PathQueue>(
-    scene: &PackedScene,
-    params: &Params,
-    paths: &mut Paths,
-    mut alive: u32,
-    queue: &mut Q,
-) {
+fn trace_paths_loop<Q: PathQueue>(scene: &PackedScene, params: &Params, queue: &mut Q) {
+    let Some(first) = queue.next(0) else { return };
+    // (Idle lanes hold copies of the first path until they take their own.)
+    let paths = &mut Paths::from_states(&[first; LANES]);
+    let mut alive = 1u32;
     let mut hits = [Hit { t: INF, tri: NO_HIT, u: 0.0, v: 0.0, instance: 0 }; LANES];
     loop {
         // Idle lanes take new paths (the first refusal holds for the rest), except when every
