@@ -164,13 +164,14 @@ fn zero_area_triangles_stay_out_of_the_tree() {
 /// time), which `trace` runs on CPUs that have it, finds the baseline walk's hits bit for bit —
 /// same triangle, t, u, v — and the same occlusion answers: random rays through triangle soups
 /// (sparse, dense, a deep tree of 200k, alpha-masked and blended, instanced and mirrored), the
-/// bundled scenes, axis-parallel and grazing rays, and rays that start on a surface.
+/// bundled scenes, axis-parallel and grazing rays, and rays that start on a surface. Two walks
+/// in step (`trace_pair`) find, for each ray, the hit it gets alone.
 #[test]
 #[cfg_attr(not(target_arch = "x86_64"), ignore = "the AVX2 walk exists on x86-64 only")]
 fn the_avx2_walk_finds_the_baseline_walks_hits() {
     #[cfg(target_arch = "x86_64")]
     {
-        use veach::cpu::bvh::{trace, trace_baseline, wide_walk_available};
+        use veach::cpu::bvh::{trace, trace_baseline, trace_pair, wide_walk_available};
         assert!(wide_walk_available(), "this CPU has no AVX2: the wide walk cannot be tested here");
         let mut rng = Lcg(41);
         let mut scenes = vec![soup(300, &mut rng), soup(3000, &mut rng), soup(200_000, &mut rng)];
@@ -184,6 +185,7 @@ fn the_avx2_walk_finds_the_baseline_walks_hits() {
             let packed = PackedScene::new(scene);
             let b = scene.bounds();
             let (lo, size) = (b.min - 0.2 * b.diagonal(), 1.4 * b.diagonal());
+            let mut traced = Vec::new();
             for k in 0..20_000 {
                 let tri =
                     &packed.triangles[(rng.f() * packed.triangles.len() as f32) as usize % packed.triangles.len()];
@@ -209,6 +211,7 @@ fn the_avx2_walk_finds_the_baseline_walks_hits() {
                     continue;
                 }
                 let ray = Ray { origin, dir };
+                traced.push(ray);
                 let (wide, base) = (trace(&packed, &ray, INF, false), trace_baseline(&packed, &ray, INF, false));
                 let bits = |h: &veach::cpu::bvh::Hit| (h.t.to_bits(), h.tri, h.u.to_bits(), h.v.to_bits(), h.instance);
                 assert_eq!(bits(&wide), bits(&base), "ray {origin} {dir}: AVX2 {wide:?} vs baseline {base:?}");
@@ -228,6 +231,24 @@ fn the_avx2_walk_finds_the_baseline_walks_hits() {
                 }
                 compared += 1;
                 hits += (base.tri != NO_HIT) as u32;
+            }
+            // Two walks in step (`trace_pair`; instanced scenes walk one after the other): each
+            // ray's hit is the one it gets traced alone, closest and any, whatever its partner.
+            let bits = |h: &veach::cpu::bvh::Hit| (h.t.to_bits(), h.tri, h.u.to_bits(), h.v.to_bits(), h.instance);
+            for (n, pair) in traced.chunks_exact(2).enumerate() {
+                let any_hit = n % 2 == 1;
+                let t_max = [if n % 3 == 0 { 0.5 } else { INF }, if n % 5 == 0 { 0.25 } else { INF }];
+                let both = trace_pair(&packed, [&pair[0], &pair[1]], t_max, any_hit);
+                for k in 0..2 {
+                    let alone = trace(&packed, &pair[k], t_max[k], any_hit);
+                    assert_eq!(
+                        bits(&both[k]),
+                        bits(&alone),
+                        "ray {:?} in a pair: {:?} alone {alone:?}",
+                        pair[k],
+                        both[k]
+                    );
+                }
             }
         }
         assert!(hits > compared / 5, "the rays should hit often ({hits} of {compared})");

@@ -333,64 +333,157 @@ fn trace_blas_walk<const WIDE: bool>(
     any_hit: bool,
     instance: u32,
 ) -> Hit {
-    let triangles: &[Triangle] = &scene.triangles;
-    #[cfg(target_arch = "x86_64")]
     let lanes = if WIDE { Some(scene.triangle_lanes()) } else { None };
-    let mut hit = best;
-    let inv_dir = safe_inv_dir(ray.dir);
-    let oct_inv4 = octant_inv4(ray.dir);
+    let mut walk = Walk::new(ray, root, best);
+    while !walk.done {
+        walk.step::<WIDE>(scene, lanes, ray, any_hit, instance);
+    }
+    walk.hit
+}
+
+/// Two rays' walks in step, one iteration of each in turn: their dependency chains (node
+/// load, box test, next node) interleave, so one ray's latencies hide behind the other's
+/// work. Each walk is `trace_blas_walk`'s, so the hits are the same bits. Written out for two
+/// (a loop over an array of walks, or four walks, lost the gain: BENCHMARKS.md session 29).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn trace_blas_walk_pair<const WIDE: bool>(
+    scene: &PackedScene,
+    rays: [&Ray; 2],
+    t_max: [f32; 2],
+    any_hit: bool,
+) -> [Hit; 2] {
+    let lanes = if WIDE { Some(scene.triangle_lanes()) } else { None };
+    let start = |t: f32| Hit { t, tri: NO_HIT, u: 0.0, v: 0.0, instance: 0 };
+    let mut a = Walk::new(rays[0], 0, start(t_max[0]));
+    let mut b = Walk::new(rays[1], 0, start(t_max[1]));
+    while !(a.done && b.done) {
+        if !a.done {
+            a.step::<WIDE>(scene, lanes, rays[0], any_hit, 0);
+        }
+        if !b.done {
+            b.step::<WIDE>(scene, lanes, rays[1], any_hit, 0);
+        }
+    }
+    [a.hit, b.hit]
+}
+
+/// A walk's state between iterations of its loop.
+struct Walk {
+    hit: Hit,
+    inv_dir: Vec3,
+    oct_inv4: u32,
     // Not zero-filled per ray: only entries below `sp` are ever read, each written first.
-    let mut stack = [std::mem::MaybeUninit::<UVec2>::uninit(); STACK_SIZE];
-    let mut sp = 0usize;
-    let mut group = UVec2::new(root, 0x80000000);
-    loop {
-        if group.y > 0x00ffffff {
-            let hits = group.y;
+    stack: [std::mem::MaybeUninit<UVec2>; STACK_SIZE],
+    sp: usize,
+    group: UVec2,
+    done: bool,
+}
+
+impl Walk {
+    #[inline(always)]
+    fn new(ray: &Ray, root: u32, best: Hit) -> Walk {
+        Walk {
+            hit: best,
+            inv_dir: safe_inv_dir(ray.dir),
+            oct_inv4: octant_inv4(ray.dir),
+            stack: [std::mem::MaybeUninit::<UVec2>::uninit(); STACK_SIZE],
+            sp: 0,
+            group: UVec2::new(root, 0x80000000),
+            done: false,
+        }
+    }
+
+    /// One iteration of the walk's loop: the next node's children tested (and its leaves'
+    /// triangles), then the next group taken; `done` once the walk has ended.
+    #[inline(always)]
+    fn step<const WIDE: bool>(
+        &mut self,
+        scene: &PackedScene,
+        lanes: Option<&crate::packed::TriangleLanes>,
+        ray: &Ray,
+        any_hit: bool,
+        instance: u32,
+    ) {
+        let oct_inv4 = self.oct_inv4;
+        if self.group.y > 0x00ffffff {
+            let hits = self.group.y;
             let child_bit = 31 - hits.leading_zeros();
-            group.y = hits & !(1 << child_bit);
-            if group.y > 0x00ffffff && sp < STACK_SIZE {
-                stack[sp].write(group);
-                sp += 1;
+            self.group.y = hits & !(1 << child_bit);
+            if self.group.y > 0x00ffffff && self.sp < STACK_SIZE {
+                self.stack[self.sp].write(self.group);
+                self.sp += 1;
             }
             let slot = (child_bit - 24) ^ (oct_inv4 & 0xff);
-            let node = load_cw_node(scene, group.x + (hits & !(u32::MAX << slot)).count_ones());
-            let mask = node_mask::<WIDE>(node, ray.origin, inv_dir, hit.t, oct_inv4);
-            group = UVec2::new(node.child_base, (mask & 0xff000000) | (node.e_imask >> 24));
+            let node = load_cw_node(scene, self.group.x + (hits & !(u32::MAX << slot)).count_ones());
+            let mask = node_mask::<WIDE>(node, ray.origin, self.inv_dir, self.hit.t, oct_inv4);
+            self.group = UVec2::new(node.child_base, (mask & 0xff000000) | (node.e_imask >> 24));
             let mut tris = mask & 0x00ffffff;
             #[cfg(target_arch = "x86_64")]
             if WIDE && tris != 0 {
-                // SAFETY: WIDE is true only inside `trace_blas_avx2`, called when the CPU has AVX2.
+                // SAFETY: WIDE is true only inside the AVX2 walks, called when the CPU has AVX2.
                 if unsafe {
-                    intersect_leaves_avx2(scene, lanes, ray, node.primitive_base, tris, &mut hit, any_hit, instance)
+                    intersect_leaves_avx2(
+                        scene,
+                        lanes,
+                        ray,
+                        node.primitive_base,
+                        tris,
+                        &mut self.hit,
+                        any_hit,
+                        instance,
+                    )
                 } {
-                    return hit;
+                    self.done = true;
+                    return;
                 }
                 tris = 0;
             }
+            #[cfg(not(target_arch = "x86_64"))]
+            let _ = lanes;
             while tris != 0 {
                 let k = 31 - tris.leading_zeros();
                 tris &= !(1 << k);
                 let i = node.primitive_base + k;
-                let tri = &triangles[i as usize];
+                let tri = &scene.triangles[i as usize];
                 let r = intersect_triangle(ray, tri);
-                if r.x < hit.t && (tri.flags & TRI_ALPHA == 0 || alpha_passes(scene, i, r.y, r.z, ray)) {
-                    hit = Hit { t: r.x, tri: i, u: r.y, v: r.z, instance };
+                if r.x < self.hit.t && (tri.flags & TRI_ALPHA == 0 || alpha_passes(scene, i, r.y, r.z, ray)) {
+                    self.hit = Hit { t: r.x, tri: i, u: r.y, v: r.z, instance };
                     if any_hit {
-                        return hit;
+                        self.done = true;
+                        return;
                     }
                 }
             }
         }
-        if group.y <= 0x00ffffff {
-            if sp == 0 {
-                break;
+        if self.group.y <= 0x00ffffff {
+            if self.sp == 0 {
+                self.done = true;
+                return;
             }
-            sp -= 1;
+            self.sp -= 1;
             // SAFETY: every entry below the stack pointer was written by the push above.
-            group = unsafe { stack[sp].assume_init() };
+            self.group = unsafe { self.stack[self.sp].assume_init() };
         }
     }
-    hit
+}
+
+/// The hits of two rays (closest, or any with `any_hit`; each before its `t_max`): in a scene
+/// without instances on a CPU with AVX2, their walks run in step (`trace_blas_walk_pair`),
+/// else one after the other. Each hit is, bit for bit, the one `trace` finds for its ray.
+pub fn trace_pair(scene: &PackedScene, rays: [&Ray; 2], t_max: [f32; 2], any_hit: bool) -> [Hit; 2] {
+    #[cfg(target_arch = "x86_64")]
+    if scene.instance_count == 0 && wide_walk_available() {
+        // SAFETY: the CPU has the features the function is compiled for (checked just above).
+        return unsafe { trace_pair_avx2(scene, rays, t_max, any_hit) };
+    }
+    [trace(scene, rays[0], t_max[0], any_hit), trace(scene, rays[1], t_max[1], any_hit)]
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,popcnt,lzcnt")]
+unsafe fn trace_pair_avx2(scene: &PackedScene, rays: [&Ray; 2], t_max: [f32; 2], any_hit: bool) -> [Hit; 2] {
+    trace_blas_walk_pair::<true>(scene, rays, t_max, any_hit)
 }
 
 /// The baseline walk, whatever the CPU: the reference the AVX2 walk is tested against.

@@ -15,7 +15,7 @@ use super::sampler::SamplerLanes;
 use super::{LANES, lanes_of};
 use crate::Strategy;
 use crate::aov::AovSample;
-use crate::cpu::bvh::{Hit, NO_HIT, intersect_closest, occluded};
+use crate::cpu::bvh::{Hit, NO_HIT, intersect_closest, occluded, trace_pair};
 use crate::cpu::common::{INF, ONE_MINUS_EPSILON, Ray};
 use crate::cpu::integrator::{
     GLOSSY_ROUGHNESS, PathState, candidate_pdf_scale, next_event_wanted, path_escaped, path_next_event, path_scatter,
@@ -187,8 +187,16 @@ fn trace_paths_loop<Q: PathQueue>(scene: &PackedScene, params: &Params, queue: &
             break;
         }
         let before = alive;
+        let ray = |i: usize| Ray { origin: paths.origin.lane(i), dir: paths.dir.lane(i) };
+        // Two walks in step (`trace_pair`: one hides the other's latencies), the odd one alone.
+        let mut lanes = lanes_of(alive);
+        while let Some(i) = lanes.next() {
+            match lanes.next() {
+                Some(j) => [hits[i], hits[j]] = trace_pair(scene, [&ray(i), &ray(j)], [INF; 2], false),
+                None => hits[i] = intersect_closest(scene, &ray(i)),
+            }
+        }
         for i in lanes_of(alive) {
-            hits[i] = intersect_closest(scene, &Ray { origin: paths.origin.lane(i), dir: paths.dir.lane(i) });
             paths.depth.0[i] += 1;
         }
         let mut plain = 0u32;
@@ -303,10 +311,18 @@ fn unoccluded(scene: &PackedScene, origin: V3, ls: &LightSampleLanes, m: M8) -> 
     let mut open = m;
     let infinite = ls.dist.eq(F8::splat(INF));
     let dir = V3::select(infinite, ls.wi, offset_ray(ls.point, ls.normal) - origin);
-    for i in lanes_of(open.bits()) {
-        let t_max = if infinite.lane(i) { INF } else { 1.0 };
-        if occluded(scene, &Ray { origin: origin.lane(i), dir: dir.lane(i) }, t_max) {
-            open.set_lane(i, false);
+    let ray = |i: usize| Ray { origin: origin.lane(i), dir: dir.lane(i) };
+    let t_max = |i: usize| if infinite.lane(i) { INF } else { 1.0 };
+    // Two walks in step (`trace_pair`: one hides the other's latencies), the odd one alone.
+    let mut lanes = lanes_of(m.bits());
+    while let Some(i) = lanes.next() {
+        match lanes.next() {
+            Some(j) => {
+                let hits = trace_pair(scene, [&ray(i), &ray(j)], [t_max(i), t_max(j)], true);
+                open.set_lane(i, hits[0].tri == NO_HIT);
+                open.set_lane(j, hits[1].tri == NO_HIT);
+            }
+            None => open.set_lane(i, !occluded(scene, &ray(i), t_max(i))),
         }
     }
     open
