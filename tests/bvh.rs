@@ -171,7 +171,9 @@ fn zero_area_triangles_stay_out_of_the_tree() {
 fn the_avx2_walk_finds_the_baseline_walks_hits() {
     #[cfg(target_arch = "x86_64")]
     {
-        use veach::cpu::bvh::{trace, trace_baseline, trace_pair, wide_walk_available};
+        use veach::cpu::bvh::{
+            Hit, intersect_closest_batch, occluded_batch, trace, trace_baseline, trace_pair, wide_walk_available,
+        };
         assert!(wide_walk_available(), "this CPU has no AVX2: the wide walk cannot be tested here");
         let mut rng = Lcg(41);
         let mut scenes = vec![soup(300, &mut rng), soup(3000, &mut rng), soup(200_000, &mut rng)];
@@ -181,6 +183,7 @@ fn the_avx2_walk_finds_the_baseline_walks_hits() {
             scenes.push(common::load_pair(&common::asset(name), None).expect("asset loads").0);
         }
         let (mut compared, mut hits) = (0, 0);
+        let bits = |h: &Hit| (h.t.to_bits(), h.tri, h.u.to_bits(), h.v.to_bits(), h.instance);
         for scene in &scenes {
             let packed = PackedScene::new(scene);
             let b = scene.bounds();
@@ -213,7 +216,6 @@ fn the_avx2_walk_finds_the_baseline_walks_hits() {
                 let ray = Ray { origin, dir };
                 traced.push(ray);
                 let (wide, base) = (trace(&packed, &ray, INF, false), trace_baseline(&packed, &ray, INF, false));
-                let bits = |h: &veach::cpu::bvh::Hit| (h.t.to_bits(), h.tri, h.u.to_bits(), h.v.to_bits(), h.instance);
                 assert_eq!(bits(&wide), bits(&base), "ray {origin} {dir}: AVX2 {wide:?} vs baseline {base:?}");
                 for t_max in [INF, base.t * 1.0001, base.t * 0.9999, 0.5] {
                     let (w, b) = (trace(&packed, &ray, t_max, true), trace_baseline(&packed, &ray, t_max, true));
@@ -234,7 +236,6 @@ fn the_avx2_walk_finds_the_baseline_walks_hits() {
             }
             // Two walks in step (`trace_pair`; instanced scenes walk one after the other): each
             // ray's hit is the one it gets traced alone, closest and any, whatever its partner.
-            let bits = |h: &veach::cpu::bvh::Hit| (h.t.to_bits(), h.tri, h.u.to_bits(), h.v.to_bits(), h.instance);
             for (n, pair) in traced.chunks_exact(2).enumerate() {
                 let any_hit = n % 2 == 1;
                 let t_max = [if n % 3 == 0 { 0.5 } else { INF }, if n % 5 == 0 { 0.25 } else { INF }];
@@ -249,6 +250,17 @@ fn the_avx2_walk_finds_the_baseline_walks_hits() {
                         both[k]
                     );
                 }
+            }
+            // The batch API (in pairs, an odd ray alone) answers as `trace` does ray by ray.
+            let odd = &traced[..traced.len() - 1 + traced.len() % 2];
+            let mut batch = vec![Hit { t: 0.0, tri: 0, u: 0.0, v: 0.0, instance: 0 }; odd.len()];
+            intersect_closest_batch(&packed, odd, &mut batch);
+            let t_max: Vec<f32> = (0..odd.len()).map(|k| if k % 3 == 0 { 0.5 } else { INF }).collect();
+            let mut blocked = vec![false; odd.len()];
+            occluded_batch(&packed, odd, &t_max, &mut blocked);
+            for (k, ray) in odd.iter().enumerate() {
+                assert_eq!(bits(&batch[k]), bits(&trace(&packed, ray, INF, false)), "batch ray {ray:?}");
+                assert_eq!(blocked[k], trace(&packed, ray, t_max[k], true).tri != NO_HIT, "batch segment {ray:?}");
             }
         }
         assert!(hits > compared / 5, "the rays should hit often ({hits} of {compared})");

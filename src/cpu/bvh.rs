@@ -573,18 +573,31 @@ pub fn occluded(scene: &PackedScene, ray: &Ray, t_max: f32) -> bool {
 
 /// The closest hits of a batch of rays, `hits[i]` for `rays[i]` (rays in order; a batch API
 /// for engines and tools that trace many rays at once: the benchmark's throughput, a
-/// wavefront's stage).
+/// wavefront's stage). Two at a time (`trace_pair`), as the renderer traces them.
 pub fn intersect_closest_batch(scene: &PackedScene, rays: &[Ray], hits: &mut [Hit]) {
-    for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
-        *hit = intersect_closest(scene, ray);
+    let n = rays.len().min(hits.len());
+    let (rays, hits) = (&rays[..n], &mut hits[..n]);
+    for (r, h) in rays.chunks(2).zip(hits.chunks_mut(2)) {
+        match r {
+            [a, b] => h.copy_from_slice(&trace_pair(scene, [a, b], [INF; 2], false)),
+            _ => h[0] = intersect_closest(scene, &r[0]),
+        }
     }
 }
 
 /// Occlusion of a batch of segments: `blocked[i]` when something lies on `rays[i]` before
-/// `t_max[i]` (any hit).
+/// `t_max[i]` (any hit). Two at a time (`trace_pair`), as the renderer traces them.
 pub fn occluded_batch(scene: &PackedScene, rays: &[Ray], t_max: &[f32], blocked: &mut [bool]) {
-    for ((ray, &t), b) in rays.iter().zip(t_max).zip(blocked.iter_mut()) {
-        *b = occluded(scene, ray, t);
+    let n = rays.len().min(t_max.len()).min(blocked.len());
+    let (rays, t_max, blocked) = (&rays[..n], &t_max[..n], &mut blocked[..n]);
+    for ((r, t), b) in rays.chunks(2).zip(t_max.chunks(2)).zip(blocked.chunks_mut(2)) {
+        match (r, t) {
+            ([ra, rb], &[ta, tb]) => {
+                let [ha, hb] = trace_pair(scene, [ra, rb], [ta, tb], true);
+                b.copy_from_slice(&[ha.tri != NO_HIT, hb.tri != NO_HIT]);
+            }
+            _ => b[0] = occluded(scene, &r[0], t[0]),
+        }
     }
 }
 
