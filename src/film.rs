@@ -61,14 +61,18 @@ pub struct Film {
 }
 
 /// A sample's value as 32.32 fixed point: (integer part, fraction × 2^32).
+#[inline]
 pub fn to_fixed(x: f32) -> (u32, u32) {
     let c = x.clamp(0.0, MAX_SAMPLE);
-    let hi = c.floor();
-    ((hi as u32), ((c - hi) * 4294967296.0) as u32)
+    // floor(c) by conversion: c ≥ 0, and every integer up to MAX_SAMPLE converts back exactly,
+    // so the same words as the kernel's floor (without a call to floorf on baseline x86-64).
+    let hi = c as u32;
+    (hi, ((c - hi as f32) * 4294967296.0) as u32)
 }
 
 /// Adds one sample to the 12 words of a pixel; non-finite samples are dropped and counted.
 /// Twin of `film_add_sample`.
+#[inline]
 pub fn film_add_sample(p: &mut [u32], l: Vec3) {
     if !l.is_finite() {
         p[7] = p[7].wrapping_add(1);

@@ -6,6 +6,7 @@ use super::sampling::sample_uniform_disk;
 use crate::params::{PROJECTION_ORTHOGRAPHIC, Params};
 use glam::{UVec2, Vec2, Vec3};
 
+#[inline]
 pub fn generate_ray(params: &Params, pixel: UVec2, u: Vec2, sampler: &mut Sampler) -> Ray {
     let x = (pixel.x as f32 + u.x) / params.image_width as f32 * 2.0 - 1.0;
     let y = 1.0 - (pixel.y as f32 + u.y) / params.image_height as f32 * 2.0;
@@ -28,6 +29,7 @@ pub fn generate_ray(params: &Params, pixel: UVec2, u: Vec2, sampler: &mut Sample
 
 /// The camera ray of `pixel` for sample `params.sample_index`, with the sampler its path goes
 /// on drawing from.
+#[inline]
 pub fn camera_sample(params: &Params, pixel: UVec2) -> (Ray, Sampler) {
     let mut sampler =
         sampler_init(params.sampler, pixel.y * params.image_width + pixel.x, params.sample_index, params.seed);

@@ -16,6 +16,7 @@ pub struct Sampler {
     state: u32,
 }
 
+#[inline]
 pub fn sampler_init(kind: u32, pixel: u32, sample_index: u32, seed: u32) -> Sampler {
     if kind == SAMPLER_INDEPENDENT {
         return Sampler {
@@ -40,6 +41,7 @@ pub fn sampler_from_parts(kind: u32, pixel_seed: u32, index: u32, dim: u32, stat
     Sampler { kind, pixel_seed, index, dim, state }
 }
 
+#[inline]
 pub fn laine_karras(v: u32, seed: u32) -> u32 {
     let mut x = v;
     x ^= x.wrapping_mul(0x3d20adea);
@@ -50,10 +52,12 @@ pub fn laine_karras(v: u32, seed: u32) -> u32 {
     x
 }
 
+#[inline]
 pub fn owen_scramble(v: u32, seed: u32) -> u32 {
     laine_karras(v.reverse_bits(), seed).reverse_bits()
 }
 
+#[inline]
 pub fn sobol_1_reversed(index: u32) -> u32 {
     let mut y = index;
     y ^= (y >> 1) & 0x5555_5555;
@@ -64,16 +68,19 @@ pub fn sobol_1_reversed(index: u32) -> u32 {
     y
 }
 
+#[inline]
 fn unit_float(bits: u32) -> f32 {
     (bits >> 8) as f32 * (1.0 / 16777216.0)
 }
 
+#[inline]
 fn next_dimension_seed(s: &mut Sampler) -> u32 {
     let d = pcg_hash(s.pixel_seed ^ pcg_hash(s.dim));
     s.dim += 1;
     d
 }
 
+#[inline]
 pub fn sample_1d(s: &mut Sampler) -> f32 {
     if s.kind == SAMPLER_INDEPENDENT {
         return rng_next(&mut s.state);
@@ -83,6 +90,7 @@ pub fn sample_1d(s: &mut Sampler) -> f32 {
     unit_float(laine_karras(i, pcg_hash(d ^ 1)).reverse_bits())
 }
 
+#[inline]
 pub fn sample_2d(s: &mut Sampler) -> Vec2 {
     if s.kind == SAMPLER_INDEPENDENT {
         let a = rng_next(&mut s.state);

@@ -45,7 +45,7 @@ pub fn lanes_of(mask: u32) -> impl Iterator<Item = usize> {
 /// eight paths at a time in the lanes of one packet. Paths start in sample-major order, and a
 /// lane whose path ends takes the next at once, so lanes stay busy however long their paths
 /// are; a pixel's next sample waits while its last is in flight. `add(params, x, radiance,
-/// aov)` receives each path's result as it ends (`params` with the path's sample index), so
+/// aov)` receives each path's result as it ends (`params` the row's), so
 /// each pixel's samples in order (the film's sums, hence its bits, do not depend on which lane
 /// ran which path).
 pub fn render_row(
@@ -98,13 +98,14 @@ impl<S: Fn(u32) -> bool, A: FnMut(&Params, u32, Vec3, &AovSample)> RowQueue<'_, 
 }
 
 impl<S: Fn(u32) -> bool, A: FnMut(&Params, u32, Vec3, &AovSample)> PathQueue for RowQueue<'_, S, A> {
+    #[inline(always)]
     fn finished(&mut self, i: usize, paths: &Paths) {
-        if let Some((s, x)) = self.running[i].take() {
-            let params = self.sample_params(s);
-            (self.add)(&params, x, paths.radiance.lane(i), &paths.aov[i]);
+        if let Some((_, x)) = self.running[i].take() {
+            (self.add)(self.params, x, paths.radiance.lane(i), &paths.aov[i]);
         }
     }
 
+    #[inline(always)]
     fn next(&mut self, i: usize) -> Option<PathState> {
         let (s, x) = self.next;
         if s >= self.end || self.running.iter().any(|r| r.is_some_and(|(_, rx)| rx == x)) {
