@@ -9,6 +9,7 @@
 //! (`integrator.rs`), so the films are the same bits (tests/lanes.rs holds the two to that).
 
 pub mod bsdf;
+pub mod camera;
 pub mod lane;
 pub mod light_tree;
 pub mod lights;
@@ -16,8 +17,6 @@ pub mod paths;
 pub mod sampler;
 pub mod trig;
 
-use super::camera::camera_sample;
-use super::integrator::PathState;
 use crate::aov::AovSample;
 use crate::packed::PackedScene;
 use crate::params::Params;
@@ -78,11 +77,6 @@ struct RowQueue<'a, S, A> {
 }
 
 impl<S: Fn(u32) -> bool, A: FnMut(&Params, u32, Vec3, &AovSample)> RowQueue<'_, S, A> {
-    /// The row's params for sample `s`.
-    fn sample_params(&self, s: u32) -> Params {
-        Params { sample_index: s, ..*self.params }
-    }
-
     /// Moves `next` past the pixels `skip` leaves out.
     fn skip_converged(&mut self) {
         let (mut s, mut x) = self.next;
@@ -106,7 +100,7 @@ impl<S: Fn(u32) -> bool, A: FnMut(&Params, u32, Vec3, &AovSample)> PathQueue for
     }
 
     #[inline(always)]
-    fn next(&mut self, i: usize) -> Option<PathState> {
+    fn next(&mut self, i: usize) -> Option<(u32, UVec2)> {
         let (s, x) = self.next;
         if s >= self.end || self.running.iter().any(|r| r.is_some_and(|(_, rx)| rx == x)) {
             return None;
@@ -114,10 +108,7 @@ impl<S: Fn(u32) -> bool, A: FnMut(&Params, u32, Vec3, &AovSample)> PathQueue for
         self.next = (s, x + 1);
         self.skip_converged();
         self.running[i] = Some((s, x));
-        let params = self.sample_params(s);
-        let pixel = UVec2::new(x + params.tile_x, self.y + params.tile_y);
-        let (ray, sampler) = camera_sample(&params, pixel);
-        Some(PathState::new(&params, ray, sampler))
+        Some((s, UVec2::new(x + self.params.tile_x, self.y + self.params.tile_y)))
     }
 
     fn pending(&self) -> bool {

@@ -8,6 +8,7 @@
 //! selection and the light sample, an emitter hit's light density, the shadow test.
 
 use super::bsdf::{BaseLanes, base_eval, base_pdf, base_sample, is_plain};
+use super::camera::camera_samples;
 use super::lane::{F8, M8, U8, V3, per_lane};
 use super::light_tree::{MAX_CANDIDATES, sample_light_tree_candidates, sample_light_tree_lanes};
 use super::lights::{LightSampleLanes, sample_lights};
@@ -25,9 +26,10 @@ use crate::cpu::light_tree::LightContext;
 use crate::cpu::lights::{light_pdf, tree_u};
 use crate::cpu::material::shading_normal;
 use crate::cpu::microfacet::DELTA_ALPHA;
+use crate::cpu::sampler::sampler_init;
 use crate::packed::{Material, PackedScene, TRI_HAS_NORMALS, TRI_MIRRORED};
 use crate::params::Params;
-use glam::{Vec3, Vec4};
+use glam::{UVec2, Vec3, Vec4};
 
 /// `PathState` of a packet, lane by lane.
 #[derive(Clone, Copy, Debug)]
@@ -123,8 +125,9 @@ impl Paths {
 pub trait PathQueue {
     /// Lane `i`'s path has ended: its radiance and AOV sample in `paths` are final.
     fn finished(&mut self, i: usize, paths: &Paths);
-    /// A path for the idle lane `i`, if one may start now.
-    fn next(&mut self, i: usize) -> Option<PathState>;
+    /// A path for the idle lane `i`, if one may start now: its sample index and pixel (film
+    /// coordinates).
+    fn next(&mut self, i: usize) -> Option<(u32, UVec2)>;
     /// Are paths left to start?
     fn pending(&self) -> bool;
 }
@@ -163,10 +166,13 @@ fn plain_material(scene: &PackedScene, params: &Params, m: &Material, index: usi
 
 #[inline(always)]
 fn trace_paths_loop<Q: PathQueue>(scene: &PackedScene, params: &Params, queue: &mut Q) {
-    let Some(first) = queue.next(0) else { return };
-    // (Idle lanes hold copies of the first path until they take their own.)
-    let paths = &mut Paths::from_states(&[first; LANES]);
-    let mut alive = 1u32;
+    if !queue.pending() {
+        return;
+    }
+    // A path as it starts, but for its ray and sampler (idle lanes hold copies).
+    let start = PathState::new(params, Ray { origin: Vec3::ZERO, dir: Vec3::Z }, sampler_init(params.sampler, 0, 0, 0));
+    let paths = &mut Paths::from_states(&[start; LANES]);
+    let mut alive = 0u32;
     let mut hits = [Hit { t: INF, tri: NO_HIT, u: 0.0, v: 0.0, instance: 0 }; LANES];
     loop {
         // Idle lanes take new paths (the first refusal holds for the rest), except when every
@@ -176,10 +182,21 @@ fn trace_paths_loop<Q: PathQueue>(scene: &PackedScene, params: &Params, queue: &
         let finishing =
             alive != 0 && params.max_depth != 0 && lanes_of(alive).all(|i| paths.depth.0[i] + 1 >= params.max_depth);
         if queue.pending() && !finishing {
+            let (mut sample, mut x, mut y) = (U8::splat(0), U8::splat(0), U8::splat(0));
+            let mut starting = 0u32;
             for i in lanes_of(!alive & ((1 << LANES) - 1)) {
-                let Some(p) = queue.next(i) else { break };
-                paths.set_lane(i, &p);
-                alive |= 1 << i;
+                let Some((s, pixel)) = queue.next(i) else { break };
+                (sample.0[i], x.0[i], y.0[i]) = (s, pixel.x, pixel.y);
+                paths.set_lane(i, &start);
+                starting |= 1 << i;
+            }
+            if starting != 0 {
+                // The new paths' camera rays and samplers, together.
+                let m = M8::from_bits(starting);
+                let (origin, dir) = camera_samples(params, sample, x, y, &mut paths.sampler, m);
+                paths.origin = V3::select(m, origin, paths.origin);
+                paths.dir = V3::select(m, dir, paths.dir);
+                alive |= starting;
             }
         }
         if alive == 0 {
