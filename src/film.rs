@@ -64,8 +64,8 @@ pub struct Film {
 #[inline]
 pub fn to_fixed(x: f32) -> (u32, u32) {
     let c = x.clamp(0.0, MAX_SAMPLE);
-    // floor(c) by conversion: c ≥ 0, and every integer up to MAX_SAMPLE converts back exactly,
-    // so the same words as the kernel's floor (without a call to floorf on baseline x86-64).
+    // floor(c) by conversion (c ≥ 0, and an f32's integer part below 2^32 converts to u32
+    // and back exactly): the kernel's `floor`, without a call to floorf on baseline x86-64.
     let hi = c as u32;
     (hi, ((c - hi as f32) * 4294967296.0) as u32)
 }
@@ -322,6 +322,28 @@ mod tests {
         assert_eq!(whole.count(0), 64);
         let mean: Vec3 = samples.iter().sum::<Vec3>() / 64.0;
         assert!((whole.mean(0) - mean).abs().max_element() < 1e-5);
+    }
+
+    #[test]
+    fn fixed_point_words_are_the_kernels_floor_split() {
+        // `to_fixed` truncates where the kernel (film.wgsl) floors: the same words for every
+        // value a sample can take, edges of f32's integer range included.
+        let floored = |x: f32| {
+            let c = x.clamp(0.0, MAX_SAMPLE);
+            let hi = c.floor();
+            (hi as u32, ((c - hi) * 4294967296.0) as u32)
+        };
+        let mut values = vec![0.0f32, -0.0, -1.5, 0.5, 1.0, 8388607.5, 8388608.0, 16777217.0, MAX_SAMPLE, 3.0e9];
+        values.extend([f32::NAN, f32::INFINITY, f32::NEG_INFINITY, f32::MIN_POSITIVE, 1.0 - f32::EPSILON / 2.0]);
+        let mut bits = 0x3f80_0000u32;
+        for _ in 0..20_000 {
+            // Values spread over many binades (a fixed LCG over the bit patterns).
+            bits = bits.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            values.push(f32::from_bits(bits & 0x4fff_ffff));
+        }
+        for x in values {
+            assert_eq!(to_fixed(x), floored(x), "{x:e}");
+        }
     }
 
     #[test]

@@ -44,9 +44,9 @@ pub fn lanes_of(mask: u32) -> impl Iterator<Item = usize> {
 /// eight paths at a time in the lanes of one packet. Paths start in sample-major order, and a
 /// lane whose path ends takes the next at once, so lanes stay busy however long their paths
 /// are; a pixel's next sample waits while its last is in flight. `add(params, x, radiance,
-/// aov)` receives each path's result as it ends (`params` the row's), so
-/// each pixel's samples in order (the film's sums, hence its bits, do not depend on which lane
-/// ran which path).
+/// aov)` receives each path's result as it ends (with the row's `params`), so each pixel's
+/// samples in order (the film's sums, hence its bits, do not depend on which lane ran which
+/// path).
 pub fn render_row(
     scene: &PackedScene,
     params: &Params,
