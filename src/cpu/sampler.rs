@@ -7,6 +7,9 @@ use glam::Vec2;
 pub const SAMPLER_INDEPENDENT: u32 = crate::SamplerKind::Independent as u32;
 pub const SAMPLER_SOBOL: u32 = crate::SamplerKind::Sobol as u32;
 
+/// Mixed into the seed before the Sobol' sampler's per-pixel hash (`sampler_init`).
+pub const SOBOL_SEED_SALT: u32 = 0x5bd1e995;
+
 #[derive(Clone, Copy, Debug)]
 pub struct Sampler {
     kind: u32,
@@ -27,7 +30,13 @@ pub fn sampler_init(kind: u32, pixel: u32, sample_index: u32, seed: u32) -> Samp
             state: rng_init(pixel, sample_index, seed),
         };
     }
-    Sampler { kind, pixel_seed: pcg_hash(pixel ^ pcg_hash(seed ^ 0x5bd1e995)), index: sample_index, dim: 0, state: 0 }
+    Sampler {
+        kind,
+        pixel_seed: pcg_hash(pixel ^ pcg_hash(seed ^ SOBOL_SEED_SALT)),
+        index: sample_index,
+        dim: 0,
+        state: 0,
+    }
 }
 
 /// The sampler's words (kind, pixel seed, sample index, dimension, PCG state), for samplers

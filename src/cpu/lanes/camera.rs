@@ -8,7 +8,7 @@ use super::lanes_of;
 use super::sampler::{SamplerLanes, pcg_hash};
 use crate::cpu::camera::generate_ray;
 use crate::cpu::rng;
-use crate::cpu::sampler::SAMPLER_INDEPENDENT;
+use crate::cpu::sampler::{SAMPLER_INDEPENDENT, SOBOL_SEED_SALT};
 use crate::params::{PROJECTION_ORTHOGRAPHIC, Params};
 use glam::{UVec2, Vec2, Vec3};
 
@@ -26,7 +26,7 @@ pub fn camera_samples(params: &Params, sample: U8, x: U8, y: U8, sampler: &mut S
         let seed_hash = rng::pcg_hash(params.seed);
         (zero, pcg_hash(pixel.zip(pcg_hash(sample.map(|s| s ^ seed_hash)), |p, h| p ^ h)))
     } else {
-        let seed_hash = rng::pcg_hash(params.seed ^ 0x5bd1e995);
+        let seed_hash = rng::pcg_hash(params.seed ^ SOBOL_SEED_SALT);
         (pcg_hash(pixel.map(|p| p ^ seed_hash)), zero)
     };
     sampler.pixel_seed = take(pixel_seed, sampler.pixel_seed);
