@@ -9,7 +9,7 @@
 //! together (`sample_light_tree_candidates`): a path's candidates at the same group step from
 //! one evaluation of its children.
 
-use super::lane::{F8, M8, V3};
+use super::lane::{F8, M8, U8, V3};
 use super::{LANES, lanes_of};
 use crate::cpu::common::ONE_MINUS_EPSILON;
 use crate::cpu::light_tree::{
@@ -70,25 +70,56 @@ struct ChildLanes {
 }
 
 impl ChildLanes {
-    /// Lane j: slot `slot(j)` of group `group(j)`.
+    /// Every lane: slot `k` of group `g` (one group seen from eight paths).
     #[inline(always)]
-    fn gather<'a>(group: impl Fn(usize) -> &'a LightGroup, slot: impl Fn(usize) -> usize) -> ChildLanes {
-        let f = |field: fn(&LightGroup) -> &[f32; 4]| F8::from_fn(|j| field(group(j))[slot(j)]);
-        let v = |field: fn(&LightGroup) -> &[[f32; 4]; 3]| axes(|a| F8::from_fn(|j| field(group(j))[a][slot(j)]));
+    fn splat(g: &LightGroup, k: usize) -> ChildLanes {
+        let f = |x: &[f32; 4]| F8::splat(x[k]);
+        let v = |x: &[[f32; 4]; 3]| axes(|a| F8::splat(x[a][k]));
         ChildLanes {
-            phi: f(|g| &g.phi),
-            lo: v(|g| &g.lo),
-            hi: v(|g| &g.hi),
-            axis: v(|g| &g.axis),
-            sin_o: f(|g| &g.sin_o),
-            cos_o: f(|g| &g.cos_o),
-            cos_e: f(|g| &g.cos_e),
-            two_sided: M8::from_fn(|j| group(j).next[slot(j)] & LIGHT_TWO_SIDED != 0),
-            one_sided: M8::from_fn(|j| group(j).one_sided[slot(j)] != 0),
-            plane_p0: v(|g| &g.plane_p0),
-            plane_n: v(|g| &g.plane_n),
+            phi: f(&g.phi),
+            lo: v(&g.lo),
+            hi: v(&g.hi),
+            axis: v(&g.axis),
+            sin_o: f(&g.sin_o),
+            cos_o: f(&g.cos_o),
+            cos_e: f(&g.cos_e),
+            two_sided: M8::splat(g.next[k] & LIGHT_TWO_SIDED != 0),
+            one_sided: M8::splat(g.one_sided[k] != 0),
+            plane_p0: v(&g.plane_p0),
+            plane_n: v(&g.plane_n),
         }
     }
+
+    /// Lanes 0–3: group `a`'s four slots, lanes 4–7: group `b`'s (two paths, each at its own
+    /// group). Each field is two 16-byte halves, as the groups store them.
+    #[inline(always)]
+    fn pair(a: &LightGroup, b: &LightGroup) -> ChildLanes {
+        let f = |x: &[f32; 4], y: &[f32; 4]| F8(join(*x, *y));
+        let v = |x: &[[f32; 4]; 3], y: &[[f32; 4]; 3]| axes(|k| F8(join(x[k], y[k])));
+        let m = |x: [u32; 4], y: [u32; 4], flag: u32| U8(join(x, y)).map(|w| w & flag).gt(0);
+        ChildLanes {
+            phi: f(&a.phi, &b.phi),
+            lo: v(&a.lo, &b.lo),
+            hi: v(&a.hi, &b.hi),
+            axis: v(&a.axis, &b.axis),
+            sin_o: f(&a.sin_o, &b.sin_o),
+            cos_o: f(&a.cos_o, &b.cos_o),
+            cos_e: f(&a.cos_e, &b.cos_e),
+            two_sided: m(a.next, b.next, LIGHT_TWO_SIDED),
+            one_sided: m(a.one_sided, b.one_sided, u32::MAX),
+            plane_p0: v(&a.plane_p0, &b.plane_p0),
+            plane_n: v(&a.plane_n, &b.plane_n),
+        }
+    }
+}
+
+/// Eight lanes from two groups' four slots (two 16-byte moves, not eight scalar inserts).
+#[inline(always)]
+fn join<T: Copy + Default>(lo: [T; WIDTH], hi: [T; WIDTH]) -> [T; LANES] {
+    let mut x = [T::default(); LANES];
+    x[..WIDTH].copy_from_slice(&lo);
+    x[WIDTH..].copy_from_slice(&hi);
+    x
 }
 
 /// `group_importance` and `group_shares`' plane test, lane by lane: the far and near
@@ -186,7 +217,7 @@ fn group_shares_lanes(c: &Contexts, g: &LightGroup) -> ([F8; WIDTH], M8) {
             // No power (an empty slot): dead for every path, as the selects make it.
             continue;
         }
-        let child = ChildLanes::gather(|_| g, |_| k);
+        let child = ChildLanes::splat(g, k);
         (far[k], near[k]) = child_importance_lanes(p, n, c.reflect_only, &child);
     }
     let total_far = far[0] + far[1] + far[2] + far[3];
@@ -207,7 +238,7 @@ fn group_shares_pair(a: (&LightContext, &LightGroup), b: (&LightContext, &LightG
     let p = axes(|k| F8::from_fn(|j| ctx(j).point[k]));
     let n = axes(|k| F8::from_fn(|j| ctx(j).normal[k]));
     let reflect_only = M8::from_fn(|j| ctx(j).reflect_only);
-    let child = ChildLanes::gather(|j| if half(j) { b.1 } else { a.1 }, |j| j % WIDTH);
+    let child = ChildLanes::pair(a.1, b.1);
     let (far, near) = child_importance_lanes(p, n, reflect_only, &child);
     // Each path's totals in slot order, as the scalar step adds them.
     let total = |x: F8, h: usize| ((x.0[h] + x.0[h + 1]) + x.0[h + 2]) + x.0[h + 3];
