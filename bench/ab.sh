@@ -33,7 +33,7 @@ mkdir -p "$dir"
 # so the dependencies build once).
 binary() {
     local sha bin wt
-    sha=$(git -C "$root" rev-parse --verify --short=12 "$1^{commit}") || { echo "bench/ab.sh: no revision '$1'" >&2; exit 2; }
+    sha=$(git -C "$root" rev-parse --verify --quiet --short=12 "$1^{commit}") || { echo "bench/ab.sh: no revision '$1'" >&2; exit 2; }
     bin=$dir/veach-$sha
     if [ ! -x "$bin" ]; then
         wt=$dir/wt-$sha
