@@ -15,8 +15,10 @@
 # is not the release build (the pin measured ≈ 1.00× there, BENCHMARKS.md session 33).
 #
 # Prints Msamples/s per run (from --stats-json's seconds_render, so loading and BVH build are
-# excluded), the pairwise CANDIDATE/BASE ratios with their median, and whether the two
-# outputs are byte-equal (a restructuring that claims the same bits must show "byte-equal").
+# excluded), the pairwise CANDIDATE/BASE ratios with their median, the ratio of each one's best
+# run, and whether the two outputs are byte-equal (a restructuring that claims the same bits
+# must show "byte-equal"). The worktrees stay registered: after `rm -rf $AB_DIR`, run
+# `git worktree prune`.
 set -euo pipefail
 
 usage() { echo "usage: bench/ab.sh BASE CANDIDATE [SCENE] [MAX_DEPTH]" >&2; exit 2; }
@@ -59,8 +61,8 @@ for _ in $(seq "$reps"); do
         bin=${!x}
         # shellcheck disable=SC2086 # EXTRA is a list of flags
         RAYON_NUM_THREADS=$threads "$bin" render "$scene" -o "$dir/out_$x.exr" --width "$size" --height "$size" \
-            --spp "$spp" --max-depth "$depth" --seed "$seed" ${EXTRA:-} --stats-json "$dir/out_$x.json" >/dev/null 2>&1 \
-            || { echo "bench/ab.sh: render with $bin failed" >&2; exit 1; }
+            --spp "$spp" --max-depth "$depth" --seed "$seed" ${EXTRA:-} --stats-json "$dir/out_$x.json" >/dev/null 2>"$dir/err_$x.txt" \
+            || { echo "bench/ab.sh: render with $bin failed: $(tail -n 1 "$dir/err_$x.txt")" >&2; exit 1; }
         if [ $x = a ]; then ra+=("$(rates "$dir/out_a.json")"); else rb+=("$(rates "$dir/out_b.json")"); fi
     done
 done
