@@ -22,6 +22,8 @@ def main():
         print("usage: bench/perf_lines.py PERF_DATA BINARY FUNCTION [LINES]", file=sys.stderr)
         sys.exit(2)
     data, binary, function = sys.argv[1:4]
+    if len(sys.argv) > 4 and not sys.argv[4].isdigit():
+        fail(f"perf_lines: LINES must be a count, not '{sys.argv[4]}'")
     lines = int(sys.argv[4]) if len(sys.argv) > 4 else 30
 
     script = subprocess.run(["perf", "script", "-i", data, "-F", "ip,sym,symoff"], capture_output=True, text=True)
@@ -35,9 +37,13 @@ def main():
             offsets[int(m.group(1), 16)] += 1
 
     symbols = subprocess.run(["nm", binary], capture_output=True, text=True).stdout.splitlines()
-    mangled = [s.split()[2] for s in symbols if len(s.split()) == 3 and function in s.split()[2]]
-    if not mangled:
-        fail(f"perf_lines: no symbol containing '{function}' in '{binary}'")
+    # The function itself, not every symbol containing its name (`trace_pair` is also a prefix
+    # of `trace_pair_avx2`): a mangled path's last part is LENGTH NAME, then the hash (and a
+    # ".llvm.N" suffix where LLVM made the symbol local).
+    exact = re.compile(str(len(function)) + re.escape(function) + r"17h[0-9a-f]{16}E(\.llvm\.\d+)?$")
+    mangled = [s.split()[2] for s in symbols if len(s.split()) == 3 and exact.search(s.split()[2])]
+    if len(mangled) != 1:
+        fail(f"perf_lines: {len(mangled)} functions named '{function}' in '{binary}' (need exactly one)")
     dis = subprocess.run(
         ["objdump", "-d", "-l", "--inlines", "--no-show-raw-insn", "--disassemble=" + mangled[0], binary],
         capture_output=True,
@@ -63,7 +69,7 @@ def main():
             continue
         m = re.match(r"^\s+([0-9a-f]+):\s+\S+", line)
         if m:
-            place[int(m.group(1), 16)] = own_frame(chain)
+            place[int(m.group(1), 16)] = own_frame(chain, function)
     if not place:
         fail(f"perf_lines: objdump gave no instructions for '{mangled[0]}'")
 
@@ -92,11 +98,12 @@ def fail(message):
     sys.exit(2)
 
 
-def own_frame(chain):
-    """The first frame in veach's sources that is not a lane operation, and its function."""
+def own_frame(chain, function):
+    """The first frame in veach's sources that is not a lane operation, and its function
+    (objdump names the outermost one by its mangled symbol: that is FUNCTION)."""
     for f, n, fn in chain:
         if "/src/" in f and "/rustc/" not in f and "/.cargo/" not in f and not f.endswith("lanes/lane.rs"):
-            return f.split("/src/")[-1] + ":" + n, re.sub(r"^_ZN.*?(\w+?)17h[0-9a-f]{16}E$", r"\1", fn)[:60]
+            return f.split("/src/")[-1] + ":" + n, function if fn.startswith("_ZN") else fn[:60]
     return "?", "?"
 
 
