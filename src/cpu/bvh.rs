@@ -169,11 +169,10 @@ unsafe fn intersect_leaves_avx2(
         if bits == 0 {
             continue;
         }
-        let first = (base + 8 * chunk) as usize;
-        // Every component array has TRIANGLE_LANES floats past any triangle, so the slice of
-        // eight exists.
-        // SAFETY: an unaligned load of the eight floats of that slice.
-        let load = |c: usize| unsafe { _mm256_loadu_ps(lanes.component(c, first)[..8].as_ptr()) };
+        let Some((first, stride)) = lanes.chunk((base + 8 * chunk) as usize) else { continue };
+        // SAFETY: an unaligned load of component c's eight floats, inside the arrays
+        // (`TriangleLanes::chunk`).
+        let load = |c: usize| unsafe { _mm256_loadu_ps(first.add(c * stride)) };
         let (p0x, p0y, p0z) = (load(0), load(1), load(2));
         let (e1x, e1y, e1z) = (load(3), load(4), load(5));
         let (e2x, e2y, e2z) = (load(6), load(7), load(8));
