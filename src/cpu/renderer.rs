@@ -60,7 +60,7 @@ struct Row<'a> {
 
 /// Samples `samples` of film row `y` (converged pixels are skipped).
 fn render_row(kernel: Kernel, scene: &PackedScene, base: &Params, samples: std::ops::Range<u32>, y: usize, row: Row) {
-    if kernel == Kernel::Lanes {
+    if kernel == Kernel::Lanes && lanes::available() {
         return render_row_lanes(scene, base, samples, y, row);
     }
     let Row { words, mut adaptive, mut aovs } = row;

@@ -2,15 +2,127 @@
 //! `V3` (three `F8`, a vector per lane). Every operation is the scalar one, lane by lane, in
 //! the same order — no fused multiply-add; `max_num`/`min_num`/`clamp` with Rust's scalar
 //! semantics; `dot`, `cross` and `normalize` as glam's `Vec3` computes them — so each lane
-//! holds the bits the scalar reference computes. They are loops over fixed arrays, which LLVM
-//! turns into single AVX2 instructions inside functions compiled for AVX2 (`super::wide`) and
-//! into SSE or NEON pairs elsewhere.
+//! holds the bits the scalar reference computes. On x86-64 the arithmetic, comparisons, selects
+//! and mask operations are AVX instructions written out (`avx`): left to LLVM's vectoriser, the
+//! loops over arrays became 128-bit halves or single lanes in much of the kernel (BENCHMARKS.md
+//! session 35), so on x86-64 the lanes run only where the CPU has AVX2 (`super::available`).
+//! Elsewhere they are loops over fixed arrays, which LLVM makes NEON pairs.
 
 use glam::Vec3;
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
 /// Lanes of a packet.
 pub const W: usize = super::LANES;
+
+/// The lane operations as AVX instructions. Every one is IEEE's operation per lane, as the
+/// scalar one: `+ − × ÷ √` round the same, the comparisons are the ordered ones Rust's `<`,
+/// `<=`, `>`, `>=`, `==` are (false with a NaN), and a mask's lanes are all ones or all zeros
+/// (every `M8` is made so), so a blend by the sign bit is the select by "≠ 0".
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use super::{F8, M8};
+    use std::arch::x86_64::*;
+    use std::mem::transmute;
+
+    // SAFETY (all of this module): the lanes run on x86-64 only on CPUs with AVX2
+    // (`lanes::available`); `F8`, `M8` and `__m256` are 32 bytes, any bits valid.
+    #[inline(always)]
+    pub fn ps(x: F8) -> __m256 {
+        unsafe { transmute(x) }
+    }
+    #[inline(always)]
+    pub fn f8(x: __m256) -> F8 {
+        unsafe { transmute(x) }
+    }
+    #[inline(always)]
+    pub fn mask(x: M8) -> __m256 {
+        unsafe { transmute(x) }
+    }
+    #[inline(always)]
+    pub fn m8(x: __m256) -> M8 {
+        unsafe { transmute(x) }
+    }
+    #[inline(always)]
+    pub fn add(a: F8, b: F8) -> F8 {
+        unsafe { f8(_mm256_add_ps(ps(a), ps(b))) }
+    }
+    #[inline(always)]
+    pub fn sub(a: F8, b: F8) -> F8 {
+        unsafe { f8(_mm256_sub_ps(ps(a), ps(b))) }
+    }
+    #[inline(always)]
+    pub fn mul(a: F8, b: F8) -> F8 {
+        unsafe { f8(_mm256_mul_ps(ps(a), ps(b))) }
+    }
+    #[inline(always)]
+    pub fn div(a: F8, b: F8) -> F8 {
+        unsafe { f8(_mm256_div_ps(ps(a), ps(b))) }
+    }
+    #[inline(always)]
+    pub fn sqrt(a: F8) -> F8 {
+        unsafe { f8(_mm256_sqrt_ps(ps(a))) }
+    }
+    /// The sign bit cleared (`f32::abs`) or flipped (`-x`).
+    #[inline(always)]
+    pub fn abs(a: F8) -> F8 {
+        unsafe { f8(_mm256_andnot_ps(_mm256_set1_ps(-0.0), ps(a))) }
+    }
+    #[inline(always)]
+    pub fn neg(a: F8) -> F8 {
+        unsafe { f8(_mm256_xor_ps(_mm256_set1_ps(-0.0), ps(a))) }
+    }
+    #[inline(always)]
+    pub fn lt(a: F8, b: F8) -> M8 {
+        unsafe { m8(_mm256_cmp_ps::<_CMP_LT_OQ>(ps(a), ps(b))) }
+    }
+    #[inline(always)]
+    pub fn le(a: F8, b: F8) -> M8 {
+        unsafe { m8(_mm256_cmp_ps::<_CMP_LE_OQ>(ps(a), ps(b))) }
+    }
+    #[inline(always)]
+    pub fn gt(a: F8, b: F8) -> M8 {
+        unsafe { m8(_mm256_cmp_ps::<_CMP_GT_OQ>(ps(a), ps(b))) }
+    }
+    #[inline(always)]
+    pub fn ge(a: F8, b: F8) -> M8 {
+        unsafe { m8(_mm256_cmp_ps::<_CMP_GE_OQ>(ps(a), ps(b))) }
+    }
+    #[inline(always)]
+    pub fn eq(a: F8, b: F8) -> M8 {
+        unsafe { m8(_mm256_cmp_ps::<_CMP_EQ_OQ>(ps(a), ps(b))) }
+    }
+    #[inline(always)]
+    pub fn select(m: M8, a: F8, b: F8) -> F8 {
+        unsafe { f8(_mm256_blendv_ps(ps(b), ps(a), mask(m))) }
+    }
+    #[inline(always)]
+    pub fn and(a: M8, b: M8) -> M8 {
+        unsafe { m8(_mm256_and_ps(mask(a), mask(b))) }
+    }
+    #[inline(always)]
+    pub fn or(a: M8, b: M8) -> M8 {
+        unsafe { m8(_mm256_or_ps(mask(a), mask(b))) }
+    }
+    #[inline(always)]
+    pub fn not(a: M8) -> M8 {
+        unsafe { m8(_mm256_xor_ps(_mm256_castsi256_ps(_mm256_set1_epi32(-1)), mask(a))) }
+    }
+    #[inline(always)]
+    pub fn bits(a: M8) -> u32 {
+        unsafe { _mm256_movemask_ps(mask(a)) as u32 }
+    }
+}
+
+/// `$avx` on x86-64 (`avx`), `$portable` elsewhere.
+macro_rules! by_arch {
+    ($avx:expr, $portable:expr) => {{
+        #[cfg(target_arch = "x86_64")]
+        let r = $avx;
+        #[cfg(not(target_arch = "x86_64"))]
+        let r = $portable;
+        r
+    }};
+}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(32))]
@@ -70,18 +182,19 @@ impl F8 {
     }
 
     #[inline(always)]
+    #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
     fn compare(self, o: F8, f: impl Fn(f32, f32) -> bool) -> M8 {
         M8(lanes(|i| if f(self.0[i], o.0[i]) { u32::MAX } else { 0 }))
     }
 
     #[inline(always)]
     pub fn sqrt(self) -> F8 {
-        self.map(f32::sqrt)
+        by_arch!(avx::sqrt(self), self.map(f32::sqrt))
     }
 
     #[inline(always)]
     pub fn abs(self) -> F8 {
-        self.map(f32::abs)
+        by_arch!(avx::abs(self), self.map(f32::abs))
     }
 
     /// `f32::max`: the other operand when one is NaN.
@@ -113,33 +226,33 @@ impl F8 {
 
     #[inline(always)]
     pub fn lt(self, o: F8) -> M8 {
-        self.compare(o, |a, b| a < b)
+        by_arch!(avx::lt(self, o), self.compare(o, |a, b| a < b))
     }
 
     #[inline(always)]
     pub fn le(self, o: F8) -> M8 {
-        self.compare(o, |a, b| a <= b)
+        by_arch!(avx::le(self, o), self.compare(o, |a, b| a <= b))
     }
 
     #[inline(always)]
     pub fn gt(self, o: F8) -> M8 {
-        self.compare(o, |a, b| a > b)
+        by_arch!(avx::gt(self, o), self.compare(o, |a, b| a > b))
     }
 
     #[inline(always)]
     pub fn ge(self, o: F8) -> M8 {
-        self.compare(o, |a, b| a >= b)
+        by_arch!(avx::ge(self, o), self.compare(o, |a, b| a >= b))
     }
 
     #[inline(always)]
     pub fn eq(self, o: F8) -> M8 {
-        self.compare(o, |a, b| a == b)
+        by_arch!(avx::eq(self, o), self.compare(o, |a, b| a == b))
     }
 
     /// `a` where `m`, else `b`.
     #[inline(always)]
     pub fn select(m: M8, a: F8, b: F8) -> F8 {
-        F8(lanes(|i| if m.0[i] != 0 { a.0[i] } else { b.0[i] }))
+        by_arch!(avx::select(m, a, b), F8(lanes(|i| if m.0[i] != 0 { a.0[i] } else { b.0[i] })))
     }
 }
 
@@ -149,21 +262,21 @@ macro_rules! float_op {
             type Output = F8;
             #[inline(always)]
             fn $f(self, o: F8) -> F8 {
-                F8(lanes(|i| self.0[i] $op o.0[i]))
+                by_arch!(avx::$f(self, o), F8(lanes(|i| self.0[i] $op o.0[i])))
             }
         }
         impl $trait<f32> for F8 {
             type Output = F8;
             #[inline(always)]
             fn $f(self, o: f32) -> F8 {
-                F8(lanes(|i| self.0[i] $op o))
+                self $op F8::splat(o)
             }
         }
         impl $trait<F8> for f32 {
             type Output = F8;
             #[inline(always)]
             fn $f(self, o: F8) -> F8 {
-                F8(lanes(|i| self $op o.0[i]))
+                F8::splat(self) $op o
             }
         }
     };
@@ -177,7 +290,7 @@ impl Neg for F8 {
     type Output = F8;
     #[inline(always)]
     fn neg(self) -> F8 {
-        self.map(|x| -x)
+        by_arch!(avx::neg(self), self.map(|x| -x))
     }
 }
 
@@ -202,11 +315,13 @@ impl M8 {
     /// Bit i set where lane i is.
     #[inline(always)]
     pub fn bits(self) -> u32 {
-        let mut b = 0;
-        for i in 0..W {
-            b |= (self.0[i] & 1) << i;
-        }
-        b
+        by_arch!(avx::bits(self), {
+            let mut b = 0;
+            for i in 0..W {
+                b |= (self.0[i] & 1) << i;
+            }
+            b
+        })
     }
 
     #[inline(always)]
@@ -224,7 +339,7 @@ impl BitAnd for M8 {
     type Output = M8;
     #[inline(always)]
     fn bitand(self, o: M8) -> M8 {
-        M8(lanes(|i| self.0[i] & o.0[i]))
+        by_arch!(avx::and(self, o), M8(lanes(|i| self.0[i] & o.0[i])))
     }
 }
 
@@ -232,7 +347,7 @@ impl BitOr for M8 {
     type Output = M8;
     #[inline(always)]
     fn bitor(self, o: M8) -> M8 {
-        M8(lanes(|i| self.0[i] | o.0[i]))
+        by_arch!(avx::or(self, o), M8(lanes(|i| self.0[i] | o.0[i])))
     }
 }
 
@@ -240,7 +355,7 @@ impl Not for M8 {
     type Output = M8;
     #[inline(always)]
     fn not(self) -> M8 {
-        M8(lanes(|i| !self.0[i]))
+        by_arch!(avx::not(self), M8(lanes(|i| !self.0[i])))
     }
 }
 

@@ -26,6 +26,17 @@ use paths::{PathQueue, Paths, trace_paths};
 /// Paths in a packet.
 pub const LANES: usize = 8;
 
+/// Can this CPU run the lanes? On x86-64 their operations are AVX instructions (`lane`), so
+/// only with AVX2 (checked at run time, a cached load); the CPU engine runs its reference
+/// kernel elsewhere, which renders the same bits. Other architectures: always.
+#[inline]
+pub fn available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    true
+}
+
 /// The lanes of `mask`, lowest first.
 #[inline(always)]
 pub fn lanes_of(mask: u32) -> impl Iterator<Item = usize> {

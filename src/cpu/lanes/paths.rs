@@ -133,16 +133,17 @@ pub trait PathQueue {
 }
 
 /// Runs the paths `queue` gives, eight at a time in the lanes of a packet, each lane taking
-/// the next path as its own ends. On x86-64 CPUs with AVX2 (checked at run time) it runs
-/// compiled for AVX2, so the lanes' arithmetic is one instruction for the packet; the
-/// operations, hence the bits, are the same either way, and so is each path's whatever lane it
-/// runs in.
+/// the next path as its own ends. On x86-64 only on CPUs with AVX2 (`lanes::available`), compiled
+/// for AVX2, so the lanes' arithmetic is one instruction for the packet; each path's bits are
+/// the same whatever lane it runs in.
 pub fn trace_paths<Q: PathQueue>(scene: &PackedScene, params: &Params, queue: &mut Q) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
+    {
+        assert!(super::available(), "the lanes kernel needs AVX2 on x86-64 (`lanes::available`)");
         // SAFETY: the CPU has AVX2 (checked just above).
-        return unsafe { trace_paths_avx2(scene, params, queue) };
+        unsafe { trace_paths_avx2(scene, params, queue) }
     }
+    #[cfg(not(target_arch = "x86_64"))]
     trace_paths_loop(scene, params, queue)
 }
 
