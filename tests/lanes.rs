@@ -26,8 +26,21 @@ fn base(width: u32, height: u32, max_depth: u32) -> Settings {
     Settings { width, height, max_depth, seed: 11, ..Settings::default() }
 }
 
+/// False (after saying so) where the CPU cannot run the lanes (x86-64 without AVX2: the
+/// engine renders with its reference kernel there, so there is nothing to compare).
+fn lanes_run(test: &str) -> bool {
+    let ok = veach::cpu::lanes::available();
+    if !ok {
+        eprintln!("SKIPPED {test}: this CPU cannot run the lanes (x86-64 without AVX2)");
+    }
+    ok
+}
+
 #[test]
 fn packets_of_paths_render_the_reference_films_bit_for_bit() {
+    if !lanes_run("packets_of_paths_render_the_reference_films_bit_for_bit") {
+        return;
+    }
     let features = features_scene("lanes");
     let asset = common::asset;
     let mut cases: Vec<(String, std::path::PathBuf, Settings, u32)> = vec![
@@ -101,6 +114,9 @@ fn packets_of_paths_render_the_reference_films_bit_for_bit() {
 /// and just below 1.
 #[test]
 fn choosing_a_child_in_lanes_matches_the_scalar_choice() {
+    if !lanes_run("choosing_a_child_in_lanes_matches_the_scalar_choice") {
+        return;
+    }
     use veach::cpu::lanes::lane::F8;
     use veach::cpu::lanes::light_tree::choose_child_lanes;
     use veach::cpu::light_tree::choose_child;
@@ -149,4 +165,101 @@ fn choosing_a_child_in_lanes_matches_the_scalar_choice() {
     }
     // Every child was chosen often (the test saw each branch of the choice).
     assert!(kinds.iter().all(|&n| n > 10_000), "children chosen {kinds:?}");
+}
+
+/// Every lane operation (AVX instructions on x86-64, loops elsewhere) is the scalar operation
+/// lane by lane, bit for bit: arithmetic, square root, sign operations, the comparisons (false
+/// with a NaN), selects, mask operations, integer steps and the saturating `as i32` — over
+/// random bit patterns (NaNs, infinities, subnormals, both zeros) and ordinary numbers.
+#[test]
+fn lane_operations_are_the_scalar_operations_bit_for_bit() {
+    use veach::cpu::lanes::lane::{F8, M8, U8};
+    if !lanes_run("lane_operations_are_the_scalar_operations_bit_for_bit") {
+        return;
+    }
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut bits = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let specials = [
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        2147483648.0,
+        -2147483648.0,
+        2147483520.0,
+        -2147483904.0,
+        1e-45,
+        1.0 / 32.0,
+    ];
+    let same = |a: F8, b: [f32; 8], what: &str, x: [f32; 8], y: [f32; 8]| {
+        for i in 0..8 {
+            assert_eq!(a.0[i].to_bits(), b[i].to_bits(), "{what} of {} and {}", x[i], y[i]);
+        }
+    };
+    let mask = |m: M8, b: [bool; 8], what: &str, x: [f32; 8], y: [f32; 8]| {
+        for i in 0..8 {
+            assert_eq!(m.0[i], if b[i] { u32::MAX } else { 0 }, "{what} of {} and {}", x[i], y[i]);
+        }
+    };
+    for _ in 0..100_000 {
+        let mut value = || {
+            let r = bits();
+            match r % 4 {
+                0 => specials[(r >> 8) as usize % specials.len()],
+                1 => f32::from_bits((r >> 16) as u32),
+                _ => ((r >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 600.0,
+            }
+        };
+        let x: [f32; 8] = std::array::from_fn(|_| value());
+        let y: [f32; 8] = std::array::from_fn(|_| value());
+        let (a, b) = (F8(x), F8(y));
+        let per = |f: &dyn Fn(f32, f32) -> f32| -> [f32; 8] { std::array::from_fn(|i| f(x[i], y[i])) };
+        same(a + b, per(&|p, q| p + q), "+", x, y);
+        same(a - b, per(&|p, q| p - q), "-", x, y);
+        same(a * b, per(&|p, q| p * q), "*", x, y);
+        same(a / b, per(&|p, q| p / q), "/", x, y);
+        same(a * 3.5, per(&|p, _| p * 3.5), "* 3.5", x, y);
+        same(0.25 - b, per(&|_, q| 0.25 - q), "0.25 -", x, y);
+        same(a.sqrt(), per(&|p, _| p.sqrt()), "sqrt", x, y);
+        same(a.abs(), per(&|p, _| p.abs()), "abs", x, y);
+        same(-a, per(&|p, _| -p), "neg", x, y);
+        let cmp = |f: &dyn Fn(f32, f32) -> bool| -> [bool; 8] { std::array::from_fn(|i| f(x[i], y[i])) };
+        mask(a.lt(b), cmp(&|p, q| p < q), "<", x, y);
+        mask(a.le(b), cmp(&|p, q| p <= q), "<=", x, y);
+        mask(a.gt(b), cmp(&|p, q| p > q), ">", x, y);
+        mask(a.ge(b), cmp(&|p, q| p >= q), ">=", x, y);
+        mask(a.eq(b), cmp(&|p, q| p == q), "==", x, y);
+        let (m, n) = (a.lt(b), a.eq(F8::splat(0.0)));
+        let (mb, nb) = (cmp(&|p, q| p < q), cmp(&|p, _| p == 0.0));
+        same(F8::select(m, a, b), per(&|p, q| if p < q { p } else { q }), "select", x, y);
+        mask(m & n, std::array::from_fn(|i| mb[i] && nb[i]), "and", x, y);
+        mask(m | n, std::array::from_fn(|i| mb[i] || nb[i]), "or", x, y);
+        mask(!m, std::array::from_fn(|i| !mb[i]), "not", x, y);
+        assert_eq!(m.bits(), (0..8).map(|i| u32::from(mb[i]) << i).sum::<u32>(), "bits of {x:?} < {y:?}");
+        let (i, j) = (a.to_i32(), b.to_bits());
+        for k in 0..8 {
+            assert_eq!(i.0[k], x[k] as i32 as u32, "{} as i32", x[k]);
+            assert_eq!(j.0[k], y[k].to_bits(), "to_bits of {}", y[k]);
+        }
+        assert_eq!(F8::from_bits(j).0.map(f32::to_bits), y.map(f32::to_bits), "from_bits");
+        let (u, v) = (
+            U8(std::array::from_fn(|_| bits() as u32)),
+            U8(std::array::from_fn(|k| if k % 3 == 0 { i.0[k] } else { bits() as u32 })),
+        );
+        for (k, &less) in mb.iter().enumerate() {
+            assert_eq!(u.reverse_bits().0[k], u.0[k].reverse_bits(), "reverse_bits of {}", u.0[k]);
+            assert_eq!(u.wrapping_add(v).0[k], u.0[k].wrapping_add(v.0[k]), "wrapping_add");
+            assert_eq!(u.wrapping_sub(v).0[k], u.0[k].wrapping_sub(v.0[k]), "wrapping_sub");
+            assert_eq!(U8::select(m, u, v).0[k], if less { u.0[k] } else { v.0[k] }, "U8 select");
+            assert_eq!(i.eq(v).0[k], if i.0[k] == v.0[k] { u32::MAX } else { 0 }, "U8 eq");
+        }
+    }
 }

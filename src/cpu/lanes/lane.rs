@@ -20,7 +20,7 @@ pub const W: usize = super::LANES;
 /// (every `M8` is made so), so a blend by the sign bit is the select by "≠ 0".
 #[cfg(target_arch = "x86_64")]
 mod avx {
-    use super::{F8, M8};
+    use super::{F8, M8, U8};
     use std::arch::x86_64::*;
     use std::mem::transmute;
 
@@ -110,6 +110,65 @@ mod avx {
     #[inline(always)]
     pub fn bits(a: M8) -> u32 {
         unsafe { _mm256_movemask_ps(mask(a)) as u32 }
+    }
+    #[inline(always)]
+    pub fn epi(x: U8) -> __m256i {
+        unsafe { transmute(x) }
+    }
+    #[inline(always)]
+    pub fn u8(x: __m256i) -> U8 {
+        unsafe { transmute(x) }
+    }
+    #[inline(always)]
+    pub fn eq_u(a: U8, b: U8) -> M8 {
+        unsafe { m8(_mm256_castsi256_ps(_mm256_cmpeq_epi32(epi(a), epi(b)))) }
+    }
+    #[inline(always)]
+    pub fn add_u(a: U8, b: U8) -> U8 {
+        unsafe { u8(_mm256_add_epi32(epi(a), epi(b))) }
+    }
+    #[inline(always)]
+    pub fn sub_u(a: U8, b: U8) -> U8 {
+        unsafe { u8(_mm256_sub_epi32(epi(a), epi(b))) }
+    }
+    #[inline(always)]
+    pub fn select_u(m: M8, a: U8, b: U8) -> U8 {
+        unsafe {
+            let (a, b) = (_mm256_castsi256_ps(epi(a)), _mm256_castsi256_ps(epi(b)));
+            u8(_mm256_castps_si256(_mm256_blendv_ps(b, a, mask(m))))
+        }
+    }
+    /// `u32::reverse_bits`: the bytes reversed in each lane, then each byte's bits through a
+    /// table of reversed nibbles.
+    #[inline(always)]
+    pub fn reverse_bits(x: U8) -> U8 {
+        unsafe {
+            let bytes = _mm256_setr_epi8(
+                3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12, 3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13,
+                12,
+            );
+            let nibbles = _mm256_setr_epi8(
+                0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf, 0x0, 0x8, 0x4, 0xc,
+                0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf,
+            );
+            let low = _mm256_set1_epi8(0x0f);
+            let v = _mm256_shuffle_epi8(epi(x), bytes);
+            let lo = _mm256_shuffle_epi8(nibbles, _mm256_and_si256(v, low));
+            let hi = _mm256_shuffle_epi8(nibbles, _mm256_and_si256(_mm256_srli_epi16::<4>(v), low));
+            u8(_mm256_or_si256(_mm256_slli_epi16::<4>(lo), hi))
+        }
+    }
+    /// Rust's `x as i32` (as bits): the truncating conversion, which gives i32::MIN for NaN
+    /// and out-of-range lanes, mended to Rust's saturation (NaN → 0, ≥ 2³¹ → i32::MAX).
+    #[inline(always)]
+    pub fn to_i32(x: F8) -> U8 {
+        unsafe {
+            let c = _mm256_castsi256_ps(_mm256_cvttps_epi32(ps(x)));
+            let big = _mm256_cmp_ps::<_CMP_GE_OQ>(ps(x), _mm256_set1_ps(2147483648.0));
+            let c = _mm256_blendv_ps(c, _mm256_castsi256_ps(_mm256_set1_epi32(i32::MAX)), big);
+            let nan = _mm256_cmp_ps::<_CMP_UNORD_Q>(ps(x), ps(x));
+            u8(_mm256_castps_si256(_mm256_andnot_ps(nan, c)))
+        }
     }
 }
 
@@ -249,6 +308,26 @@ impl F8 {
         by_arch!(avx::eq(self, o), self.compare(o, |a, b| a == b))
     }
 
+    /// Each lane's bits (`f32::to_bits`).
+    #[inline(always)]
+    pub fn to_bits(self) -> U8 {
+        // SAFETY: [f32; W] and [u32; W] have the same size, any bits valid.
+        U8(unsafe { std::mem::transmute::<[f32; W], [u32; W]>(self.0) })
+    }
+
+    /// The floats with bits `b` (`f32::from_bits`).
+    #[inline(always)]
+    pub fn from_bits(b: U8) -> F8 {
+        // SAFETY: as in `to_bits`.
+        F8(unsafe { std::mem::transmute::<[u32; W], [f32; W]>(b.0) })
+    }
+
+    /// `x as i32` lane by lane (NaN → 0, out of range → the nearest end), as the i32's bits.
+    #[inline(always)]
+    pub fn to_i32(self) -> U8 {
+        by_arch!(avx::to_i32(self), U8(lanes(|i| self.0[i] as i32 as u32)))
+    }
+
     /// `a` where `m`, else `b`.
     #[inline(always)]
     pub fn select(m: M8, a: F8, b: F8) -> F8 {
@@ -378,6 +457,32 @@ impl U8 {
     #[inline(always)]
     pub fn zip(self, o: U8, f: impl Fn(u32, u32) -> u32) -> U8 {
         U8(lanes(|i| f(self.0[i], o.0[i])))
+    }
+
+    #[inline(always)]
+    pub fn eq(self, o: U8) -> M8 {
+        by_arch!(avx::eq_u(self, o), M8(lanes(|i| if self.0[i] == o.0[i] { u32::MAX } else { 0 })))
+    }
+
+    #[inline(always)]
+    pub fn reverse_bits(self) -> U8 {
+        by_arch!(avx::reverse_bits(self), self.map(u32::reverse_bits))
+    }
+
+    #[inline(always)]
+    pub fn wrapping_add(self, o: U8) -> U8 {
+        by_arch!(avx::add_u(self, o), self.zip(o, u32::wrapping_add))
+    }
+
+    #[inline(always)]
+    pub fn wrapping_sub(self, o: U8) -> U8 {
+        by_arch!(avx::sub_u(self, o), self.zip(o, u32::wrapping_sub))
+    }
+
+    /// `a` where `m`, else `b`.
+    #[inline(always)]
+    pub fn select(m: M8, a: U8, b: U8) -> U8 {
+        by_arch!(avx::select_u(m, a, b), U8(lanes(|i| if m.0[i] != 0 { a.0[i] } else { b.0[i] })))
     }
 
     #[inline(always)]

@@ -331,13 +331,14 @@ impl<const N: usize> Walks<N> {
         }
     }
 
-    /// The walks among `mask` that stand at group `group` (a loop over every walk, which the
-    /// compiler makes a few vector compares).
+    /// The walks among `mask` that stand at group `group`: eight walks' groups compared at
+    /// once.
     #[inline(always)]
     fn at(&self, mask: u32, group: u32) -> u32 {
+        let key = U8::splat(group);
         let mut here = 0u32;
-        for (e, &g) in self.group.iter().enumerate() {
-            here |= u32::from(g == group) << e;
+        for c in (0..N).step_by(LANES) {
+            here |= U8::from_fn(|j| self.group[c + j]).eq(key).bits() << c;
         }
         here & mask
     }

@@ -83,6 +83,14 @@ impl LightSampleLanes {
     }
 }
 
+/// `receiver_cosine_weights`' cosine at triangle vertex `v` seen from `ref_point` with normal
+/// `n`. A function, not a closure: a closure the compiler leaves out of line is compiled
+/// without AVX, and its lane operations become calls (BENCHMARKS.md session 35).
+#[inline(always)]
+fn receiver_cosine(n: V3, ref_point: V3, v: V3) -> F8 {
+    n.dot(normalize_or_zero(v - ref_point)).abs().max_num(F8::splat(0.01))
+}
+
 /// glam's `normalize_or_zero`: v / |v| when 1 / |v| is finite and positive, else 0.
 #[inline(always)]
 fn normalize_or_zero(v: V3) -> V3 {
@@ -269,8 +277,9 @@ pub fn sample_lights(
     if spherical != 0 {
         // receiver_cosine_weights
         let n = V3::from_fn(|i| ctx[i].normal);
-        let cosine = |v: V3| n.dot(normalize_or_zero(v - ref_point)).abs().max_num(F8::splat(0.01));
-        let (c0, c1, c2) = (cosine(p0), cosine(p0 + e1), cosine(p0 + e2));
+        let c0 = receiver_cosine(n, ref_point, p0);
+        let c1 = receiver_cosine(n, ref_point, p0 + e1);
+        let c2 = receiver_cosine(n, ref_point, p0 + e2);
         let weights = [c1, c1, c0, c2];
         // sample_bilinear
         let y = sample_linear(u.2, weights[0] + weights[1], weights[2] + weights[3]);

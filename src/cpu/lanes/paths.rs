@@ -287,18 +287,20 @@ fn glossy_lobe(r: F8) -> M8 {
 /// near the origin), the scalar's operations lane by lane.
 #[inline(always)]
 fn offset_ray(p: V3, n: V3) -> V3 {
-    let axis = |pc: F8, nc: F8| {
-        F8::from_fn(|i| {
-            let (pc, nc) = (pc.0[i], nc.0[i]);
-            let o = (256.0 * nc) as i32;
-            // (wrapping_neg: the scalar's `-o` wherever it is defined; lanes not in use may
-            // hold anything.)
-            let pi =
-                f32::from_bits((pc.to_bits() as i32).wrapping_add(if pc < 0.0 { o.wrapping_neg() } else { o }) as u32);
-            if pc.abs() < 1.0 / 32.0 { pc + (1.0 / 65536.0) * nc } else { pi }
-        })
-    };
-    V3::new(axis(p.x, n.x), axis(p.y, n.y), axis(p.z, n.z))
+    V3::new(offset_axis(p.x, n.x), offset_axis(p.y, n.y), offset_axis(p.z, n.z))
+}
+
+/// One axis of `offset_ray` (a function: a closure left out of line would be compiled without
+/// AVX, `lights::receiver_cosine`).
+#[inline(always)]
+fn offset_axis(pc: F8, nc: F8) -> F8 {
+    // The scalar's integer step: `(256 n) as i32`, negated where p < 0 (wrapping, as the
+    // scalar's `-o` wherever it is defined; lanes not in use may hold anything), added to p's
+    // bits.
+    let o = (256.0 * nc).to_i32();
+    let o = U8::select(pc.lt(F8::splat(0.0)), U8::splat(0).wrapping_sub(o), o);
+    let pi = F8::from_bits(pc.to_bits().wrapping_add(o));
+    F8::select(pc.abs().lt(F8::splat(1.0 / 32.0)), pc + (1.0 / 65536.0) * nc, pi)
 }
 
 /// `spawn_point` in lanes: the origin of a ray leaving `point` towards `wi`.
@@ -473,10 +475,12 @@ impl Reservoir {
 #[inline(never)]
 fn resample_lights(scene: &PackedScene, params: &Params, paths: &mut Paths, sv: &VertexLanes, m: M8) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
+    {
+        assert!(super::available(), "the lanes kernel needs AVX2 on x86-64 (`lanes::available`)");
         // SAFETY: the CPU has AVX2 (checked just above).
-        return unsafe { resample_lights_avx2(scene, params, paths, sv, m) };
+        unsafe { resample_lights_avx2(scene, params, paths, sv, m) }
     }
+    #[cfg(not(target_arch = "x86_64"))]
     resample_lights_loop(scene, params, paths, sv, m)
 }
 

@@ -26,7 +26,7 @@ pub fn laine_karras(v: U8, seed: U8) -> U8 {
 
 #[inline(always)]
 fn reverse_bits(v: U8) -> U8 {
-    v.map(u32::reverse_bits)
+    v.reverse_bits()
 }
 
 #[inline(always)]
