@@ -7,6 +7,9 @@
 //! `light_tree.rs`), the light sample, the shadow test — runs lane by lane. Every path draws
 //! the same numbers and does the same operations in the same order as the scalar reference
 //! (`integrator.rs`), so the films are the same bits (tests/lanes.rs holds the two to that).
+//! On x86-64 the lanes' operations are AVX instructions: call into this module only where
+//! `available()` says the CPU has AVX2 (the engine does so, and runs its reference kernel
+//! elsewhere).
 
 pub mod bsdf;
 pub mod camera;
